@@ -1,0 +1,1 @@
+//! Camera, rasterizer and tone mapping (placeholder: being written).

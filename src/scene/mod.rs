@@ -1,0 +1,90 @@
+//! The scene as loaded: polygons, materials (reflectance ρ, emission), and the lights.
+//!
+//! This module owns everything that knows about OBJ/MTL (`obj.rs`, the only code that touches
+//! `tobj`) and the built-in default scene (`default.rs`). Downstream code sees only [`Scene`].
+//!
+//! Units (DESIGN.md §1): metres; MTL `Ke` is emitted *radiance* (W/sr/m²) as path tracers and
+//! Radiance read it, so a Lambertian emitter's radiosity is E = π·Ke (W/m²).
+
+mod default;
+mod obj;
+
+pub use default::{default_scene, DEFAULT_SCENE_MTL, DEFAULT_SCENE_NAME, DEFAULT_SCENE_OBJ};
+pub use obj::{load_obj, load_obj_from_strs, LoadOptions, SceneError};
+
+use glam::Vec3;
+use std::f64::consts::PI;
+
+/// A diffuse material: reflectance ρ per RGB channel and emitted radiance `Ke`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Diffuse reflectance ρ (MTL `Kd`), each channel in [0, 1).
+    pub rho: [f64; 3],
+    /// Emitted radiance (MTL `Ke` or `--emit`), W/sr/m².
+    pub ke: [f64; 3],
+}
+
+impl Material {
+    /// Emitted radiosity E = π·Ke (W/m²) of a Lambertian emitter.
+    pub fn emission(&self) -> [f64; 3] {
+        self.ke.map(|k| PI * k)
+    }
+
+    pub fn is_emitter(&self) -> bool {
+        self.ke.iter().any(|&k| k > 0.0)
+    }
+}
+
+/// One face of the model: a run of `len` vertex indices starting at `first` in
+/// [`Scene::indices`], wound counter-clockwise seen from the front.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Polygon {
+    pub first: u32,
+    pub len: u32,
+    pub material: u32,
+}
+
+/// A loaded model. Flat arrays so a million-polygon model costs no allocation per face.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// Where it came from (a path, or the built-in scene's name); used in messages.
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    /// Vertex indices of all polygons, back to back.
+    pub indices: Vec<u32>,
+    pub polygons: Vec<Polygon>,
+    pub materials: Vec<Material>,
+    /// Non-fatal problems met while loading (missing MTL, dropped zero-area faces, …).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// The vertex indices of polygon `p`.
+    pub fn polygon_indices(&self, p: &Polygon) -> &[u32] {
+        &self.indices[p.first as usize..(p.first + p.len) as usize]
+    }
+
+    /// Axis-aligned bounds (min, max) of all positions used by polygons.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for &i in &self.indices {
+            let p = self.positions[i as usize];
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        if self.indices.is_empty() {
+            (Vec3::ZERO, Vec3::ZERO)
+        } else {
+            (lo, hi)
+        }
+    }
+
+    /// Does any material emit?
+    pub fn has_emitter(&self) -> bool {
+        self.polygons
+            .iter()
+            .any(|p| self.materials[p.material as usize].is_emitter())
+    }
+}
