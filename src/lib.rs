@@ -10,6 +10,9 @@
 //! solution on. The `radiosity` binary is a thin layer over this library.
 #![deny(unsafe_code)]
 
+pub mod intersect;
 pub mod mesh;
 pub mod render;
+pub mod sample;
 pub mod scene;
+pub mod solve;

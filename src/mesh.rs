@@ -59,3 +59,418 @@ impl Mesh {
         &self.patch_vertices[p.first as usize..(p.first + p.count) as usize]
     }
 }
+
+use crate::scene::Scene;
+use std::collections::HashMap;
+
+/// How to cut the scene into patches.
+#[derive(Clone, Debug, Default)]
+pub struct MeshOptions {
+    /// Longest patch edge (metres); `None` derives one from the scene ([`default_patch_size`]).
+    pub patch_size: Option<f32>,
+    /// Give every polygon a back patch of its own (thin surfaces seen from both sides).
+    pub two_sided: bool,
+}
+
+/// Patch count the derived default patch size aims at: enough to show soft shadows in a room,
+/// few enough that the default solve takes seconds.
+const DEFAULT_PATCH_TARGET: f64 = 1500.0;
+
+/// A patch size derived from the scene: the "nice" length (1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 × 10^k)
+/// closest to sqrt(total area / 1500), so a room comes out at roughly 1–2 thousand patches.
+pub fn default_patch_size(scene: &Scene) -> f32 {
+    let total: f64 = scene
+        .polygons
+        .iter()
+        .map(|p| newell(&polygon_points(scene, p)).length() as f64 * 0.5)
+        .sum();
+    if total <= 0.0 || !total.is_finite() {
+        return 1.0;
+    }
+    nice_length((total / DEFAULT_PATCH_TARGET).sqrt())
+}
+
+fn nice_length(x: f64) -> f32 {
+    let exp = x.log10().floor();
+    let base = 10f64.powf(exp);
+    let m = x / base;
+    let steps: [f64; 10] = [1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0];
+    let best = steps
+        .iter()
+        .copied()
+        .min_by(|a, b| (a.ln() - m.ln()).abs().total_cmp(&(b.ln() - m.ln()).abs()))
+        .unwrap_or(1.0);
+    (best * base) as f32
+}
+
+fn polygon_points(scene: &Scene, p: &crate::scene::Polygon) -> Vec<Vec3> {
+    scene
+        .polygon_indices(p)
+        .iter()
+        .map(|&i| scene.positions[i as usize])
+        .collect()
+}
+
+/// Newell's normal of a polygon: its direction is the front normal, its length twice the area.
+/// Computed in f64 about the first vertex so large coordinates keep their precision.
+pub fn newell(pts: &[Vec3]) -> Vec3 {
+    let o = pts[0].as_dvec3();
+    let mut n = glam::DVec3::ZERO;
+    for k in 0..pts.len() {
+        let a = pts[k].as_dvec3() - o;
+        let b = pts[(k + 1) % pts.len()].as_dvec3() - o;
+        n += a.cross(b);
+    }
+    n.as_vec3()
+}
+
+/// Builds the patches of `scene`.
+pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
+    let size = opts
+        .patch_size
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .unwrap_or_else(|| default_patch_size(scene));
+    let (lo, hi) = scene.bounds();
+    let mut b = Builder::new(size, (hi - lo).length().max(f32::MIN_POSITIVE));
+    for (pi, poly) in scene.polygons.iter().enumerate() {
+        let pts = polygon_points(scene, poly);
+        for piece in planar_convex_pieces(&pts) {
+            b.add_polygon(&piece, poly.material, pi as u32, false);
+            if opts.two_sided {
+                b.add_polygon(&piece, poly.material, pi as u32, true);
+            }
+        }
+    }
+    b.mesh
+}
+
+/// Splits a face into planar convex pieces: itself when it already is one, else triangles
+/// (ear clipping in the plane of its Newell normal).
+fn planar_convex_pieces(pts: &[Vec3]) -> Vec<Vec<Vec3>> {
+    let n = newell(pts);
+    if pts.len() == 3 || (is_planar(pts, n) && is_convex(pts, n)) {
+        return vec![pts.to_vec()];
+    }
+    ear_clip(pts, n)
+}
+
+fn is_planar(pts: &[Vec3], n: Vec3) -> bool {
+    let n = n.normalize_or_zero();
+    let c = pts.iter().copied().sum::<Vec3>() / pts.len() as f32;
+    let diam = pts.iter().map(|p| (*p - c).length()).fold(0.0f32, f32::max);
+    pts.iter()
+        .all(|p| (*p - c).dot(n).abs() <= 1e-4 * diam.max(f32::MIN_POSITIVE))
+}
+
+fn is_convex(pts: &[Vec3], n: Vec3) -> bool {
+    let m = pts.len();
+    (0..m).all(|k| {
+        let a = pts[k];
+        let b = pts[(k + 1) % m];
+        let c = pts[(k + 2) % m];
+        (b - a).cross(c - b).dot(n) >= -1e-9 * n.length_squared()
+    })
+}
+
+/// Ear clipping of a simple polygon, projected onto the plane of its normal `n`.
+fn ear_clip(pts: &[Vec3], n: Vec3) -> Vec<Vec<Vec3>> {
+    let n = n.normalize_or_zero();
+    let u = n.any_orthonormal_vector();
+    let v = n.cross(u);
+    let p2: Vec<glam::DVec2> = pts
+        .iter()
+        .map(|p| glam::dvec2(p.dot(u) as f64, p.dot(v) as f64))
+        .collect();
+    let cross = |a: glam::DVec2, b: glam::DVec2, c: glam::DVec2| (b - a).perp_dot(c - a);
+    let mut idx: Vec<usize> = (0..pts.len()).collect();
+    let mut out = Vec::new();
+    let mut guard = 0;
+    while idx.len() > 3 && guard < 10 * pts.len() {
+        guard += 1;
+        let m = idx.len();
+        let mut clipped = false;
+        for k in 0..m {
+            let (ia, ib, ic) = (idx[(k + m - 1) % m], idx[k], idx[(k + 1) % m]);
+            let (a, b, c) = (p2[ia], p2[ib], p2[ic]);
+            if cross(a, b, c) <= 0.0 {
+                continue; // reflex corner
+            }
+            let inside = idx.iter().any(|&j| {
+                j != ia
+                    && j != ib
+                    && j != ic
+                    && cross(a, b, p2[j]) >= 0.0
+                    && cross(b, c, p2[j]) >= 0.0
+                    && cross(c, a, p2[j]) >= 0.0
+            });
+            if !inside {
+                out.push(vec![pts[ia], pts[ib], pts[ic]]);
+                idx.remove(k);
+                clipped = true;
+                break;
+            }
+        }
+        if !clipped {
+            break;
+        }
+    }
+    if idx.len() >= 3 {
+        // What is left (a triangle, or a degenerate remainder): fan it.
+        for k in 1..idx.len() - 1 {
+            out.push(vec![pts[idx[0]], pts[idx[k]], pts[idx[k + 1]]]);
+        }
+    }
+    out
+}
+
+/// Accumulates patches and welds their vertices by (position, facing).
+struct Builder {
+    mesh: Mesh,
+    size: f32,
+    /// Weld grid cell size: positions closer than this (and facing the same way) are one vertex.
+    quantum: f32,
+    weld: HashMap<([i64; 3], [i32; 3]), u32>,
+}
+
+impl Builder {
+    fn new(size: f32, diagonal: f32) -> Self {
+        Builder {
+            mesh: Mesh {
+                patch_size: size,
+                ..Mesh::default()
+            },
+            size,
+            quantum: diagonal * 1e-6,
+            weld: HashMap::new(),
+        }
+    }
+
+    fn vertex(&mut self, p: Vec3, n: Vec3) -> u32 {
+        let q = |x: f32| (x / self.quantum).round() as i64;
+        let qn = |x: f32| (x * 1000.0).round() as i32;
+        let key = ([q(p.x), q(p.y), q(p.z)], [qn(n.x), qn(n.y), qn(n.z)]);
+        let next = self.mesh.vertices.len() as u32;
+        let id = *self.weld.entry(key).or_insert(next);
+        if id == next {
+            self.mesh.vertices.push(p);
+        }
+        id
+    }
+
+    /// Cuts one planar convex polygon into patches no longer than the patch size.
+    fn add_polygon(&mut self, pts: &[Vec3], material: u32, polygon: u32, back: bool) {
+        let pts: Vec<Vec3> = if back {
+            pts.iter().rev().copied().collect()
+        } else {
+            pts.to_vec()
+        };
+        let n = newell(&pts).normalize_or_zero();
+        if n == Vec3::ZERO {
+            return;
+        }
+        let s = self.size;
+        let div = |len: f32| ((len / s).ceil() as usize).max(1);
+        match pts.len() {
+            3 => {
+                let longest = (0..3)
+                    .map(|k| (pts[(k + 1) % 3] - pts[k]).length())
+                    .fold(0.0, f32::max);
+                let k = div(longest);
+                self.add_subdivided_triangle(&pts, k, n, material, polygon);
+            }
+            4 => {
+                let along_u = (pts[1] - pts[0]).length().max((pts[2] - pts[3]).length());
+                let along_v = (pts[3] - pts[0]).length().max((pts[2] - pts[1]).length());
+                let (m, k) = (div(along_u), div(along_v));
+                // Bilinear grid: iso-u and iso-v lines of a planar convex quad are straight,
+                // so every cell is a planar convex quad with edges ≤ the patch size.
+                let at = |i: usize, j: usize| {
+                    let (u, v) = (i as f32 / m as f32, j as f32 / k as f32);
+                    let a = pts[0].lerp(pts[1], u);
+                    let b = pts[3].lerp(pts[2], u);
+                    a.lerp(b, v)
+                };
+                let grid: Vec<u32> = (0..=k)
+                    .flat_map(|j| (0..=m).map(move |i| (i, j)))
+                    .map(|(i, j)| at(i, j))
+                    .collect::<Vec<_>>()
+                    .into_iter()
+                    .map(|p| self.vertex(p, n))
+                    .collect();
+                let g = |i: usize, j: usize| grid[j * (m + 1) + i];
+                for j in 0..k {
+                    for i in 0..m {
+                        let ids = [g(i, j), g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)];
+                        self.push_patch(&ids, n, material, polygon);
+                    }
+                }
+            }
+            count => {
+                let longest = (0..count)
+                    .map(|k| (pts[(k + 1) % count] - pts[k]).length())
+                    .fold(0.0, f32::max);
+                let c = pts.iter().copied().sum::<Vec3>() / count as f32;
+                let radius = pts.iter().map(|p| (*p - c).length()).fold(0.0, f32::max);
+                if longest <= s && radius <= s {
+                    let ids: Vec<u32> = pts.iter().map(|&p| self.vertex(p, n)).collect();
+                    self.push_patch(&ids, n, material, polygon);
+                } else {
+                    // A large n-gon: fan from its centroid, then cut each triangle.
+                    for e in 0..count {
+                        let tri = [c, pts[e], pts[(e + 1) % count]];
+                        let longest = (0..3)
+                            .map(|q| (tri[(q + 1) % 3] - tri[q]).length())
+                            .fold(0.0, f32::max);
+                        self.add_subdivided_triangle(&tri, div(longest), n, material, polygon);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Cuts a triangle into k² similar triangles on a barycentric grid (edges = original / k).
+    fn add_subdivided_triangle(
+        &mut self,
+        t: &[Vec3],
+        k: usize,
+        n: Vec3,
+        material: u32,
+        polygon: u32,
+    ) {
+        let at = |i: usize, j: usize| {
+            // Point i steps along t0→t1 and j steps along t0→t2.
+            t[0] + (t[1] - t[0]) * (i as f32 / k as f32) + (t[2] - t[0]) * (j as f32 / k as f32)
+        };
+        let mut row_start = Vec::with_capacity(k + 1);
+        let mut ids = Vec::new();
+        for j in 0..=k {
+            row_start.push(ids.len());
+            for i in 0..=(k - j) {
+                let p = if i + j == k && j == 0 {
+                    t[1]
+                } else if i == 0 && j == k {
+                    t[2]
+                } else {
+                    at(i, j)
+                };
+                ids.push(self.vertex(p, n));
+            }
+        }
+        let g = |i: usize, j: usize| ids[row_start[j] + i];
+        for j in 0..k {
+            for i in 0..(k - j) {
+                self.push_patch(&[g(i, j), g(i + 1, j), g(i, j + 1)], n, material, polygon);
+                if i + j + 1 < k {
+                    self.push_patch(
+                        &[g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)],
+                        n,
+                        material,
+                        polygon,
+                    );
+                }
+            }
+        }
+    }
+
+    fn push_patch(&mut self, ids: &[u32], n: Vec3, material: u32, polygon: u32) {
+        let pts: Vec<Vec3> = ids
+            .iter()
+            .map(|&i| self.mesh.vertices[i as usize])
+            .collect();
+        let nn = newell(&pts);
+        let area = nn.length() as f64 * 0.5;
+        if area <= 0.0 {
+            return;
+        }
+        // The centroid of the polygon's area (not of its vertices), from its fan triangles.
+        let mut c = glam::DVec3::ZERO;
+        let mut a_sum = 0.0;
+        for k in 1..pts.len() - 1 {
+            let (a, b, d) = (pts[0].as_dvec3(), pts[k].as_dvec3(), pts[k + 1].as_dvec3());
+            let ak = (b - a).cross(d - a).length() * 0.5;
+            c += (a + b + d) / 3.0 * ak;
+            a_sum += ak;
+        }
+        let centre = if a_sum > 0.0 {
+            (c / a_sum).as_vec3()
+        } else {
+            pts[0]
+        };
+        let first = self.mesh.patch_vertices.len() as u32;
+        self.mesh.patch_vertices.extend_from_slice(ids);
+        self.mesh.patches.push(Patch {
+            first,
+            count: ids.len() as u32,
+            material,
+            polygon,
+            area,
+            centre,
+            normal: n,
+            class: classify(&pts, n),
+        });
+    }
+}
+
+/// Sec. 2: a patch is axial when it lies in a plane x, y or z = const (all its vertices share
+/// that coordinate), so the plane-merge intersector can take it; otherwise skew.
+fn classify(pts: &[Vec3], n: Vec3) -> PatchClass {
+    let a = n.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    if n.abs()[axis] < 1.0 - 1e-6 {
+        return PatchClass::Skew;
+    }
+    let c = pts[0][axis];
+    let tol = 1e-6 * c.abs().max(1.0);
+    if pts.iter().all(|p| (p[axis] - c).abs() <= tol) {
+        PatchClass::Axial([Axis::X, Axis::Y, Axis::Z][axis])
+    } else {
+        PatchClass::Skew
+    }
+}
+
+impl Mesh {
+    /// Total patch area.
+    pub fn total_area(&self) -> f64 {
+        self.patches.iter().map(|p| p.area).sum()
+    }
+
+    /// Per-vertex values for display: the area-weighted mean of the patches sharing the vertex
+    /// (vertices are welded only within one facing, so creases stay sharp).
+    pub fn vertex_values(&self, patch_values: &[[f64; 3]]) -> Vec<[f32; 3]> {
+        let mut sum = vec![[0.0f64; 3]; self.vertices.len()];
+        let mut w = vec![0.0f64; self.vertices.len()];
+        for (i, p) in self.patches.iter().enumerate() {
+            for &v in self.patch_indices(i) {
+                for c in 0..3 {
+                    sum[v as usize][c] += patch_values[i][c] * p.area;
+                }
+                w[v as usize] += p.area;
+            }
+        }
+        sum.iter()
+            .zip(&w)
+            .map(|(s, &w)| {
+                if w > 0.0 {
+                    s.map(|x| (x / w) as f32)
+                } else {
+                    [0.0; 3]
+                }
+            })
+            .collect()
+    }
+
+    /// Fan triangles of every patch, as (vertex indices, patch id): what Embree and the
+    /// rasterizer consume.
+    pub fn triangles(&self) -> impl Iterator<Item = ([u32; 3], u32)> + '_ {
+        (0..self.patches.len()).flat_map(move |i| {
+            let ids = self.patch_indices(i);
+            (1..ids.len() - 1).map(move |k| ([ids[0], ids[k], ids[k + 1]], i as u32))
+        })
+    }
+}

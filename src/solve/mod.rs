@@ -1,0 +1,140 @@
+//! Solvers: progressive refinement by shooting (Cohen et al. 1988) with the adaptive
+//! polar hemisphere sampler of Airey & Ouh-young (1989, Sec. 2).
+//!
+//! Notation follows the papers: patch `i` shoots, patch `j` receives; `b` is radiosity
+//! (W/m²), `e` emitted radiosity, `rho` reflectance; energies are fluxes Φ = B·A in f64 per RGB
+//! channel. A shot moves the shooter's unshot flux ΔΦ_i into the scene: each ray carries
+//! ΔΦ_i / X and the patch it hits first gains ρ_j·ΔΦ_i/X (so ΔB_j += ρ_j·ΔΦ_i·F_ij/A_j with
+//! F_ij estimated by the fraction of rays).
+
+pub mod progressive;
+
+pub use progressive::solve;
+
+use std::time::Duration;
+
+/// What the solver does, independent of the scene.
+#[derive(Clone, Debug)]
+pub struct SolveConfig {
+    /// Seed of every random choice; the result depends on it and nothing else (not the number
+    /// of threads).
+    pub seed: u64,
+    /// Requested relative sampling error of a typical patch's radiosity; sets the energy per
+    /// ray (see [`progressive::energy_per_ray`]).
+    pub tolerance: f64,
+    /// Overrides the energy per ray C (W, scalar flux) derived from `tolerance`.
+    pub energy_per_ray: Option<f64>,
+    /// Sec. 3: stop when max unshot radiosity < this fraction of the mean radiosity (0.0006).
+    pub stop_fraction: f64,
+    pub max_time: Option<Duration>,
+    pub max_rays: Option<u64>,
+    /// Place each ray uniformly inside its polar cell (default) rather than at its centre.
+    pub jitter: bool,
+}
+
+impl Default for SolveConfig {
+    fn default() -> Self {
+        SolveConfig {
+            seed: 1,
+            tolerance: 0.05,
+            energy_per_ray: None,
+            stop_fraction: 0.0006,
+            max_time: None,
+            max_rays: None,
+            jitter: true,
+        }
+    }
+}
+
+/// Why the solve stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StopReason {
+    /// Sec. 3: max unshot radiosity fell below the requested fraction of the mean radiosity.
+    Converged,
+    /// No unshot energy left at all.
+    Exhausted,
+    MaxTime,
+    MaxRays,
+}
+
+/// One point of the convergence trace.
+#[derive(Clone, Copy, Debug, serde::Serialize)]
+pub struct TracePoint {
+    pub time_s: f64,
+    pub shots: u64,
+    pub rays: u64,
+    /// Max unshot radiosity over patches (scalar: mean of RGB), W/m².
+    pub max_unshot_b: f64,
+    /// Area-weighted mean radiosity (scalar), W/m².
+    pub mean_b: f64,
+    /// Total unshot flux (scalar), W.
+    pub unshot_flux: f64,
+}
+
+/// Where the emitted energy went (W per RGB channel). emitted = absorbed + absorbed_back +
+/// escaped + unshot, to rounding.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct EnergyBalance {
+    pub emitted: [f64; 3],
+    /// Absorbed by front faces: (1 − ρ) of what they received.
+    pub absorbed: [f64; 3],
+    /// Arrived on back faces (absorbed there; a large share means flipped normals).
+    pub absorbed_back: [f64; 3],
+    /// Left an open scene.
+    pub escaped: [f64; 3],
+    /// Still waiting to be shot.
+    pub unshot: [f64; 3],
+}
+
+impl EnergyBalance {
+    /// |emitted − (absorbed + back + escaped + unshot)| / emitted, worst channel.
+    pub fn relative_residual(&self) -> f64 {
+        (0..3)
+            .map(|c| {
+                let out =
+                    self.absorbed[c] + self.absorbed_back[c] + self.escaped[c] + self.unshot[c];
+                if self.emitted[c] > 0.0 {
+                    (self.emitted[c] - out).abs() / self.emitted[c]
+                } else {
+                    0.0
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// Fraction of the emitted flux (scalar) that arrived on back faces.
+    pub fn back_fraction(&self) -> f64 {
+        scalar(&self.absorbed_back) / scalar(&self.emitted).max(f64::MIN_POSITIVE)
+    }
+}
+
+/// Counters of a solve.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct SolveStats {
+    pub shots: u64,
+    pub rays: u64,
+    pub waves: u64,
+    pub seconds: f64,
+    /// Energy per ray C (scalar W) the run used.
+    pub energy_per_ray: f64,
+    pub stop_reason: Option<StopReason>,
+    pub energy: EnergyBalance,
+    pub trace: Vec<TracePoint>,
+}
+
+/// The result: radiosity per patch, and the energy not yet shot.
+#[derive(Clone, Debug)]
+pub struct Solution {
+    /// Radiosity B_i per patch (W/m²), RGB.
+    pub b: Vec<[f64; 3]>,
+    /// Unshot flux ΔΦ_i per patch (W), RGB.
+    pub unshot: Vec<[f64; 3]>,
+    pub stats: SolveStats,
+}
+
+/// The scalar the solver ranks and stops by: the mean of the three channels.
+#[inline]
+pub fn scalar(v: &[f64; 3]) -> f64 {
+    (v[0] + v[1] + v[2]) / 3.0
+}
