@@ -10,9 +10,15 @@
 //! solution on. The `radiosity` binary is a thin layer over this library.
 #![deny(unsafe_code)]
 
+pub mod error;
+pub mod export;
 pub mod intersect;
 pub mod mesh;
+pub mod pipeline;
 pub mod render;
+pub mod report;
 pub mod sample;
 pub mod scene;
 pub mod solve;
+
+pub use error::Error;

@@ -1,0 +1,36 @@
+//! The library's error: one enum over the areas' own errors, each displayed as one line that
+//! names the file and what is wrong. [`Error::exit_code`] says whose fault it is.
+
+use crate::export::WriteError;
+use crate::intersect::embree::EmbreeError;
+use crate::scene::SceneError;
+use crate::solve::progressive::SolveError;
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    #[error("{scene}: {source}")]
+    Solve {
+        scene: String,
+        #[source]
+        source: SolveError,
+    },
+    #[error(transparent)]
+    Write(#[from] WriteError),
+    #[error(transparent)]
+    Embree(#[from] EmbreeError),
+    /// A bad setting (flag value, combination).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl Error {
+    /// 2 for what the user can fix (input, flags, output folder), 1 for internal failures.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::Embree(_) => 1,
+            _ => 2,
+        }
+    }
+}

@@ -1,0 +1,103 @@
+//! The patch table (DESIGN.md §5): one CSV row per patch, stable ids in mesh order,
+//! `id, cx, cy, cz, nx, ny, nz, area, rho_r, rho_g, rho_b, e_r, e_g, e_b, b_r, b_g, b_b`
+//! (B = radiosity in W/m²; irradiance = (B − E)/ρ).
+
+use crate::mesh::Mesh;
+use crate::scene::Material;
+use std::io::{self, BufRead, Write};
+
+/// The header, exactly as other tools script against it.
+pub const HEADER: &str = "id,cx,cy,cz,nx,ny,nz,area,rho_r,rho_g,rho_b,e_r,e_g,e_b,b_r,b_g,b_b";
+
+/// Writes the table. Non-finite values never reach the file: they are an error.
+pub fn write(
+    w: &mut dyn Write,
+    mesh: &Mesh,
+    materials: &[Material],
+    b: &[[f64; 3]],
+) -> io::Result<()> {
+    writeln!(w, "{HEADER}")?;
+    for (i, p) in mesh.patches.iter().enumerate() {
+        let m = &materials[p.material as usize];
+        let e = m.emission();
+        let vals = [
+            p.centre.x as f64,
+            p.centre.y as f64,
+            p.centre.z as f64,
+            p.normal.x as f64,
+            p.normal.y as f64,
+            p.normal.z as f64,
+            p.area,
+            m.rho[0],
+            m.rho[1],
+            m.rho[2],
+            e[0],
+            e[1],
+            e[2],
+            b[i][0],
+            b[i][1],
+            b[i][2],
+        ];
+        if vals.iter().any(|v| !v.is_finite()) {
+            return Err(io::Error::other(format!(
+                "patch {i} has a non-finite value"
+            )));
+        }
+        write!(w, "{i}")?;
+        for v in vals {
+            write!(w, ",{v}")?;
+        }
+        writeln!(w)?;
+    }
+    Ok(())
+}
+
+/// One row read back.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub id: usize,
+    pub values: [f64; 16],
+}
+
+impl Row {
+    pub fn area(&self) -> f64 {
+        self.values[6]
+    }
+    pub fn b(&self) -> [f64; 3] {
+        [self.values[13], self.values[14], self.values[15]]
+    }
+}
+
+/// Reads a patch table written by [`write`] (for references and comparisons).
+pub fn read(r: impl BufRead) -> io::Result<Vec<Row>> {
+    let bad = |line: usize, what: &str| {
+        io::Error::new(io::ErrorKind::InvalidData, format!("line {line}: {what}"))
+    };
+    let mut rows = Vec::new();
+    for (k, line) in r.lines().enumerate() {
+        let line = line?;
+        if k == 0 {
+            if line.trim() != HEADER {
+                return Err(bad(1, "not a patch table (unexpected header)"));
+            }
+            continue;
+        }
+        if line.trim().is_empty() {
+            continue;
+        }
+        let mut it = line.split(',');
+        let id = it
+            .next()
+            .and_then(|s| s.trim().parse().ok())
+            .ok_or_else(|| bad(k + 1, "bad id"))?;
+        let mut values = [0.0; 16];
+        for v in values.iter_mut() {
+            *v = it
+                .next()
+                .and_then(|s| s.trim().parse().ok())
+                .ok_or_else(|| bad(k + 1, "missing or bad number"))?;
+        }
+        rows.push(Row { id, values });
+    }
+    Ok(rows)
+}

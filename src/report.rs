@@ -1,0 +1,246 @@
+//! What a run reports: the JSON summary of a solve and the description of a scene (`info`).
+
+use crate::mesh::{Mesh, PatchClass};
+use crate::scene::Scene;
+use crate::solve::{scalar, EnergyBalance, SolveStats, StopReason, TracePoint};
+use serde::Serialize;
+
+/// An emitting material and the power it puts out.
+#[derive(Clone, Debug, Serialize)]
+pub struct LightInfo {
+    pub material: String,
+    /// Emitted radiosity E = π·Ke, W/m².
+    pub emission: [f64; 3],
+    /// Area of its patches, m².
+    pub area: f64,
+    /// Emitted power Φ = E·A, W per channel.
+    pub power: [f64; 3],
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct MaterialInfo {
+    pub name: String,
+    pub rho: [f64; 3],
+    pub ke: [f64; 3],
+    pub polygons: usize,
+}
+
+/// `radiosity info`: what a scene is made of.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneInfo {
+    pub scene: String,
+    pub polygons: usize,
+    pub patches: usize,
+    pub patch_size: f32,
+    pub suggested_patch_size: f32,
+    pub axial_fraction_count: f64,
+    pub axial_fraction_area: f64,
+    pub total_area: f64,
+    pub bounds_min: [f32; 3],
+    pub bounds_max: [f32; 3],
+    pub materials: Vec<MaterialInfo>,
+    pub lights: Vec<LightInfo>,
+    pub warnings: Vec<String>,
+}
+
+/// Axis-aligned share of the patches, by count and by area.
+pub fn axial_fractions(mesh: &Mesh) -> (f64, f64) {
+    let n = mesh.patches.len().max(1) as f64;
+    let total = mesh.total_area().max(f64::MIN_POSITIVE);
+    let (mut c, mut a) = (0usize, 0.0);
+    for p in &mesh.patches {
+        if matches!(p.class, PatchClass::Axial(_)) {
+            c += 1;
+            a += p.area;
+        }
+    }
+    (c as f64 / n, a / total)
+}
+
+/// Lights, by emitting material.
+pub fn lights(scene: &Scene, mesh: &Mesh) -> Vec<LightInfo> {
+    let mut area = vec![0.0; scene.materials.len()];
+    for p in &mesh.patches {
+        area[p.material as usize] += p.area;
+    }
+    scene
+        .materials
+        .iter()
+        .enumerate()
+        .filter(|(k, m)| m.is_emitter() && area[*k] > 0.0)
+        .map(|(k, m)| {
+            let e = m.emission();
+            LightInfo {
+                material: m.name.clone(),
+                emission: e,
+                area: area[k],
+                power: e.map(|x| x * area[k]),
+            }
+        })
+        .collect()
+}
+
+pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
+    let (fc, fa) = axial_fractions(mesh);
+    let (lo, hi) = scene.bounds();
+    let mut count = vec![0usize; scene.materials.len()];
+    for p in &scene.polygons {
+        count[p.material as usize] += 1;
+    }
+    SceneInfo {
+        scene: scene.name.clone(),
+        polygons: scene.polygons.len(),
+        patches: mesh.patches.len(),
+        patch_size: mesh.patch_size,
+        suggested_patch_size: suggested,
+        axial_fraction_count: fc,
+        axial_fraction_area: fa,
+        total_area: mesh.total_area(),
+        bounds_min: lo.to_array(),
+        bounds_max: hi.to_array(),
+        materials: scene
+            .materials
+            .iter()
+            .zip(&count)
+            .map(|(m, &polygons)| MaterialInfo {
+                name: m.name.clone(),
+                rho: m.rho,
+                ke: m.ke,
+                polygons,
+            })
+            .collect(),
+        lights: lights(scene, mesh),
+        warnings: scene.warnings.clone(),
+    }
+}
+
+impl std::fmt::Display for SceneInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "scene          {}", self.scene)?;
+        writeln!(f, "polygons       {}", self.polygons)?;
+        writeln!(
+            f,
+            "patches        {} at patch size {} m (suggested {} m)",
+            self.patches, self.patch_size, self.suggested_patch_size
+        )?;
+        writeln!(
+            f,
+            "axis-aligned   {:.1} % of patches, {:.1} % of area",
+            100.0 * self.axial_fraction_count,
+            100.0 * self.axial_fraction_area
+        )?;
+        writeln!(f, "surface area   {:.4} m²", self.total_area)?;
+        let (lo, hi) = (self.bounds_min, self.bounds_max);
+        writeln!(
+            f,
+            "bounds         [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}] m (size {:.4} × {:.4} × {:.4})",
+            lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]
+        )?;
+        writeln!(f, "materials      {}", self.materials.len())?;
+        for m in &self.materials {
+            writeln!(
+                f,
+                "  {:<20} rho {:.3} {:.3} {:.3}  Ke {} {} {}  ({} polygons)",
+                m.name, m.rho[0], m.rho[1], m.rho[2], m.ke[0], m.ke[1], m.ke[2], m.polygons
+            )?;
+        }
+        writeln!(f, "lights         {}", self.lights.len())?;
+        for l in &self.lights {
+            writeln!(
+                f,
+                "  {:<20} E {:.4} {:.4} {:.4} W/m² over {:.4} m²: {:.4} {:.4} {:.4} W",
+                l.material,
+                l.emission[0],
+                l.emission[1],
+                l.emission[2],
+                l.area,
+                l.power[0],
+                l.power[1],
+                l.power[2]
+            )?;
+        }
+        for w in &self.warnings {
+            writeln!(f, "warning: {w}")?;
+        }
+        Ok(())
+    }
+}
+
+/// Wall time of each phase of a solve, seconds.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Timings {
+    pub load: f64,
+    pub mesh: f64,
+    pub build: f64,
+    pub solve: f64,
+    pub output: f64,
+    pub total: f64,
+}
+
+/// The energy balance with its residual (DESIGN.md: emitted = absorbed + unshot + escaped).
+#[derive(Clone, Debug, Serialize)]
+pub struct EnergyReport {
+    #[serde(flatten)]
+    pub balance: EnergyBalance,
+    /// |emitted − accounted| / emitted, worst channel.
+    pub relative_residual: f64,
+    /// Share of the emitted flux that arrived on back faces.
+    pub back_fraction: f64,
+    pub escaped_fraction: f64,
+}
+
+impl From<&EnergyBalance> for EnergyReport {
+    fn from(b: &EnergyBalance) -> Self {
+        EnergyReport {
+            balance: *b,
+            relative_residual: b.relative_residual(),
+            back_fraction: b.back_fraction(),
+            escaped_fraction: scalar(&b.escaped) / scalar(&b.emitted).max(f64::MIN_POSITIVE),
+        }
+    }
+}
+
+/// The JSON summary of a solve (`summary.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    pub version: &'static str,
+    pub scene: String,
+    pub polygons: usize,
+    pub patches: usize,
+    pub patch_size: f32,
+    pub axial_fraction_area: f64,
+    pub lights: Vec<LightInfo>,
+    pub method: &'static str,
+    pub intersector: &'static str,
+    pub seed: u64,
+    pub threads: usize,
+    pub tolerance: f64,
+    pub energy_per_ray: f64,
+    pub stop_fraction: f64,
+    pub stop_reason: Option<StopReason>,
+    pub shots: u64,
+    pub rays: u64,
+    pub waves: u64,
+    /// Rays cast per second of solve time.
+    pub rays_per_second: f64,
+    pub seconds: Timings,
+    pub energy: EnergyReport,
+    /// Final max unshot radiosity over the mean radiosity (Sec. 3's criterion).
+    pub max_unshot_over_mean: f64,
+    pub warnings: Vec<String>,
+    pub outputs: Vec<String>,
+    /// The max-unshot trace, against time and shots.
+    pub trace: Vec<TracePoint>,
+}
+
+impl Summary {
+    pub fn stats_line(stats: &SolveStats) -> String {
+        format!(
+            "{} shots, {} rays in {:.2} s ({:.2} Mrays/s)",
+            stats.shots,
+            stats.rays,
+            stats.seconds,
+            stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+        )
+    }
+}
