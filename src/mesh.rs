@@ -474,3 +474,181 @@ impl Mesh {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Material, Polygon};
+    use glam::vec3;
+
+    fn scene_of(faces: &[&[Vec3]]) -> Scene {
+        let mut s = Scene {
+            materials: vec![Material {
+                name: "m".into(),
+                rho: [0.5; 3],
+                ke: [0.0; 3],
+            }],
+            ..Scene::default()
+        };
+        for f in faces {
+            let base = s.positions.len() as u32;
+            s.positions.extend_from_slice(f);
+            let first = s.indices.len() as u32;
+            s.indices.extend(base..base + f.len() as u32);
+            s.polygons.push(Polygon {
+                first,
+                len: f.len() as u32,
+                material: 0,
+            });
+        }
+        s
+    }
+
+    fn opts(size: f32) -> MeshOptions {
+        MeshOptions {
+            patch_size: Some(size),
+            two_sided: false,
+        }
+    }
+
+    fn longest_edge(m: &Mesh) -> f32 {
+        (0..m.patches.len())
+            .flat_map(|i| {
+                let ids = m.patch_indices(i);
+                (0..ids.len()).map(move |k| {
+                    (m.vertices[ids[(k + 1) % ids.len()] as usize] - m.vertices[ids[k] as usize])
+                        .length()
+                })
+            })
+            .fold(0.0, f32::max)
+    }
+
+    #[test]
+    fn quad_is_cut_into_a_welded_grid_keeping_area() {
+        let quad = [
+            vec3(0., 0., 0.),
+            vec3(2., 0., 0.),
+            vec3(2., 0., -1.),
+            vec3(0., 0., -1.),
+        ];
+        let m = build(&scene_of(&[&quad]), &opts(0.5));
+        assert_eq!(m.patches.len(), 4 * 2);
+        assert_eq!(m.vertices.len(), 5 * 3, "grid vertices are shared");
+        assert!((m.total_area() - 2.0).abs() < 1e-6);
+        assert!(longest_edge(&m) <= 0.5 + 1e-6);
+        for p in &m.patches {
+            assert_eq!(p.count, 4, "quads stay quads");
+            assert!((p.normal - Vec3::Y).length() < 1e-6);
+            assert_eq!(p.class, PatchClass::Axial(Axis::Y));
+        }
+    }
+
+    #[test]
+    fn triangle_and_large_ngon_keep_their_area() {
+        let tri = [vec3(0., 0., 0.), vec3(1., 0., 1.), vec3(0., 1., 0.3)];
+        let hexagon: Vec<Vec3> = (0..6)
+            .map(|k| {
+                let a = k as f32 * std::f32::consts::TAU / 6.0;
+                vec3(a.cos(), a.sin(), 0.0)
+            })
+            .collect();
+        let s = scene_of(&[&tri, &hexagon]);
+        let m = build(&s, &opts(0.3));
+        let tri_area = 0.5 * newell(&tri).length() as f64;
+        let hex_area = 3.0 * 3f64.sqrt() / 2.0;
+        assert!((m.total_area() - tri_area - hex_area).abs() < 1e-5);
+        assert!(longest_edge(&m) <= 0.3 + 1e-5);
+        let skew = m
+            .patches
+            .iter()
+            .filter(|p| p.class == PatchClass::Skew)
+            .count();
+        assert!(skew > 0 && skew < m.patches.len());
+    }
+
+    #[test]
+    fn non_convex_and_non_planar_faces_are_triangulated() {
+        // An L-shape (non-convex) and a twisted quad (non-planar).
+        let l = [
+            vec3(0., 0., 0.),
+            vec3(2., 0., 0.),
+            vec3(2., 1., 0.),
+            vec3(1., 1., 0.),
+            vec3(1., 2., 0.),
+            vec3(0., 2., 0.),
+        ];
+        let twisted = [
+            vec3(0., 0., 5.),
+            vec3(1., 0., 5.),
+            vec3(1., 1., 5.3),
+            vec3(0., 1., 5.),
+        ];
+        let m = build(&scene_of(&[&l, &twisted]), &opts(10.0));
+        let l_patches: Vec<_> = m.patches.iter().filter(|p| p.polygon == 0).collect();
+        assert_eq!(l_patches.len(), 4, "a hexagonal L needs 4 triangles");
+        assert!(l_patches.iter().all(|p| p.count == 3));
+        let l_area: f64 = l_patches.iter().map(|p| p.area).sum();
+        assert!((l_area - 3.0).abs() < 1e-6);
+        assert!(m
+            .patches
+            .iter()
+            .filter(|p| p.polygon == 1)
+            .all(|p| p.count == 3));
+    }
+
+    #[test]
+    fn two_sided_adds_opposite_patches_with_their_own_vertices() {
+        let quad = [
+            vec3(0., 0., 0.),
+            vec3(1., 0., 0.),
+            vec3(1., 1., 0.),
+            vec3(0., 1., 0.),
+        ];
+        let m = build(
+            &scene_of(&[&quad]),
+            &MeshOptions {
+                patch_size: Some(0.5),
+                two_sided: true,
+            },
+        );
+        assert_eq!(m.patches.len(), 8);
+        let back = m.patches.iter().filter(|p| p.normal.z < 0.0).count();
+        assert_eq!(back, 4);
+        assert_eq!(m.vertices.len(), 18, "front and back never share a vertex");
+    }
+
+    #[test]
+    fn crease_vertices_are_not_welded_but_coplanar_ones_are() {
+        let floor_a = [
+            vec3(0., 0., 0.),
+            vec3(0., 0., 1.),
+            vec3(1., 0., 1.),
+            vec3(1., 0., 0.),
+        ];
+        let floor_b = [
+            vec3(1., 0., 0.),
+            vec3(1., 0., 1.),
+            vec3(2., 0., 1.),
+            vec3(2., 0., 0.),
+        ];
+        let wall = [
+            vec3(0., 0., 0.),
+            vec3(1., 0., 0.),
+            vec3(1., 1., 0.),
+            vec3(0., 1., 0.),
+        ];
+        let m = build(&scene_of(&[&floor_a, &floor_b, &wall]), &opts(5.0));
+        // floors share 2 vertices (6 in all); the wall shares none with them (4 more).
+        assert_eq!(m.vertices.len(), 10);
+        let vals = m.vertex_values(&[[1.0; 3], [3.0; 3], [7.0; 3]]);
+        let shared = m.patch_indices(1)[0] as usize; // (1,0,0) on floor_b
+        assert_eq!(vals[shared], [2.0; 3]);
+    }
+
+    #[test]
+    fn default_patch_size_is_a_nice_length() {
+        assert_eq!(nice_length(0.0356), 0.04);
+        assert_eq!(nice_length(0.6), 0.6);
+        assert_eq!(nice_length(13.0), 15.0);
+    }
+}

@@ -121,6 +121,14 @@ struct Shot {
     grid: PolarGrid,
 }
 
+/// a += b, per channel.
+#[inline]
+fn add3(a: &mut [f64; 3], b: &[f64; 3]) {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
+}
+
 /// splitmix64: decorrelates (seed, shot, chunk) into independent RNG seeds.
 fn mix(mut z: u64) -> u64 {
     z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
@@ -242,9 +250,7 @@ pub fn solve<I: Intersector>(
     let mut unshot: Vec<[f64; 3]> = b.iter().zip(&area).map(|(e, a)| e.map(|x| x * a)).collect();
     let mut energy = EnergyBalance::default();
     for u in &unshot {
-        for c in 0..3 {
-            energy.emitted[c] += u[c];
-        }
+        add3(&mut energy.emitted, u);
     }
     if scalar(&energy.emitted) <= 0.0 {
         return Err(SolveError::NoEmitter);
@@ -378,13 +384,9 @@ pub fn solve<I: Intersector>(
             let phi_ray = shot.phi.map(|p| p / shot.grid.len() as f64);
             for &code in codes {
                 if code == ESCAPED {
-                    for c in 0..3 {
-                        energy.escaped[c] += phi_ray[c];
-                    }
+                    add3(&mut energy.escaped, &phi_ray);
                 } else if code & BACK != 0 {
-                    for c in 0..3 {
-                        energy.absorbed_back[c] += phi_ray[c];
-                    }
+                    add3(&mut energy.absorbed_back, &phi_ray);
                 } else {
                     let j = code as usize;
                     for c in 0..3 {
@@ -414,9 +416,7 @@ pub fn solve<I: Intersector>(
     }
 
     for u in &unshot {
-        for c in 0..3 {
-            energy.unshot[c] += u[c];
-        }
+        add3(&mut energy.unshot, u);
     }
     stats.energy = energy;
     stats.stop_reason = Some(stop_reason);
