@@ -72,7 +72,7 @@ struct SceneArgs {
     #[arg(long, value_name = "MATERIAL=R,G,B", value_parser = parse_emit)]
     emit: Vec<(String, [f64; 3])>,
     /// Longest patch edge in metres (default: derived from the scene, and printed).
-    #[arg(long, value_name = "METRES")]
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     patch_size: Option<f32>,
     /// Give every polygon a back patch of its own (thin surfaces lit from both sides).
     #[arg(long)]
@@ -88,17 +88,22 @@ struct SolverArgs {
     /// Relative sampling error wanted for a typical patch's radiosity. Sets the energy each ray
     /// carries (Sec. 2: rays in proportion to unshot energy): about patches/tolerance² rays in
     /// all, so halving it costs 4× the rays.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
     tolerance: f64,
     /// Energy per ray C in watts (overrides --tolerance).
-    #[arg(long, value_name = "WATTS")]
+    #[arg(long, value_name = "WATTS", allow_negative_numbers = true)]
     energy_per_ray: Option<f64>,
     /// Stop when the max unshot radiosity is below this fraction of the mean radiosity
     /// (paper Sec. 3: 0.06 %).
-    #[arg(long, default_value_t = 0.0006, value_name = "FRACTION")]
+    #[arg(
+        long,
+        default_value_t = 0.0006,
+        value_name = "FRACTION",
+        allow_negative_numbers = true
+    )]
     stop: f64,
     /// Stop after this many seconds of solving, whatever the criterion says.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     max_time: Option<f64>,
     /// Stop after about this many rays.
     #[arg(long)]
@@ -130,14 +135,14 @@ struct SolveArgs {
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     up: Option<Vec3>,
     /// Vertical field of view in degrees.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     fov: Option<f32>,
     #[arg(long, default_value_t = 640)]
     width: u32,
     #[arg(long, default_value_t = 480)]
     height: u32,
     /// Exposure multiplier on radiosity (default: automatic).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     exposure: Option<f32>,
     /// Print nothing but errors.
     #[arg(long, short)]
@@ -190,7 +195,6 @@ impl SceneArgs {
     fn load(&self) -> LoadOptions {
         LoadOptions {
             emit: self.emit.clone(),
-            ..LoadOptions::default()
         }
     }
     fn mesh(&self) -> MeshOptions {

@@ -5,8 +5,9 @@
 //! convex n-gons stay whole when small enough; non-planar or non-convex faces are triangulated
 //! first. A patch faces its winding's normal (counter-clockwise seen from the front).
 //!
-//! Vertices are welded across polygons only where position *and* facing agree, so Gouraud
-//! interpolation smooths over a wall's own patches but never across a crease.
+//! Vertices are welded across polygons only where position, facing *and* material agree, so
+//! Gouraud interpolation smooths over a wall's own patches but never across a crease, and a
+//! light's radiosity never bleeds into the ceiling around it.
 
 use glam::Vec3;
 
@@ -229,7 +230,7 @@ struct Builder {
     size: f32,
     /// Weld grid cell size: positions closer than this (and facing the same way) are one vertex.
     quantum: f32,
-    weld: HashMap<([i64; 3], [i32; 3]), u32>,
+    weld: HashMap<([i64; 3], [i32; 3], u32), u32>,
 }
 
 impl Builder {
@@ -245,10 +246,14 @@ impl Builder {
         }
     }
 
-    fn vertex(&mut self, p: Vec3, n: Vec3) -> u32 {
+    fn vertex(&mut self, p: Vec3, n: Vec3, material: u32) -> u32 {
         let q = |x: f32| (x / self.quantum).round() as i64;
         let qn = |x: f32| (x * 1000.0).round() as i32;
-        let key = ([q(p.x), q(p.y), q(p.z)], [qn(n.x), qn(n.y), qn(n.z)]);
+        let key = (
+            [q(p.x), q(p.y), q(p.z)],
+            [qn(n.x), qn(n.y), qn(n.z)],
+            material,
+        );
         let next = self.mesh.vertices.len() as u32;
         let id = *self.weld.entry(key).or_insert(next);
         if id == next {
@@ -295,7 +300,7 @@ impl Builder {
                     .map(|(i, j)| at(i, j))
                     .collect::<Vec<_>>()
                     .into_iter()
-                    .map(|p| self.vertex(p, n))
+                    .map(|p| self.vertex(p, n, material))
                     .collect();
                 let g = |i: usize, j: usize| grid[j * (m + 1) + i];
                 for j in 0..k {
@@ -312,7 +317,7 @@ impl Builder {
                 let c = pts.iter().copied().sum::<Vec3>() / count as f32;
                 let radius = pts.iter().map(|p| (*p - c).length()).fold(0.0, f32::max);
                 if longest <= s && radius <= s {
-                    let ids: Vec<u32> = pts.iter().map(|&p| self.vertex(p, n)).collect();
+                    let ids: Vec<u32> = pts.iter().map(|&p| self.vertex(p, n, material)).collect();
                     self.push_patch(&ids, n, material, polygon);
                 } else {
                     // A large n-gon: fan from its centroid, then cut each triangle.
@@ -353,7 +358,7 @@ impl Builder {
                 } else {
                     at(i, j)
                 };
-                ids.push(self.vertex(p, n));
+                ids.push(self.vertex(p, n, material));
             }
         }
         let g = |i: usize, j: usize| ids[row_start[j] + i];

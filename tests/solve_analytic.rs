@@ -58,13 +58,40 @@ fn two_squares(parallel: bool) -> Scene {
         ..Scene::default()
     };
     // a: the unit square in z = 0, facing +z.
-    quad(&mut s, [vec3(0., 0., 0.), vec3(1., 0., 0.), vec3(1., 1., 0.), vec3(0., 1., 0.)], 0);
+    quad(
+        &mut s,
+        [
+            vec3(0., 0., 0.),
+            vec3(1., 0., 0.),
+            vec3(1., 1., 0.),
+            vec3(0., 1., 0.),
+        ],
+        0,
+    );
     if parallel {
         // b: in z = 1, facing −z.
-        quad(&mut s, [vec3(0., 0., 1.), vec3(0., 1., 1.), vec3(1., 1., 1.), vec3(1., 0., 1.)], 1);
+        quad(
+            &mut s,
+            [
+                vec3(0., 0., 1.),
+                vec3(0., 1., 1.),
+                vec3(1., 1., 1.),
+                vec3(1., 0., 1.),
+            ],
+            1,
+        );
     } else {
         // b: in y = 0, x and z in [0, 1], facing +y; shares the edge y = z = 0 with a.
-        quad(&mut s, [vec3(0., 0., 0.), vec3(0., 0., 1.), vec3(1., 0., 1.), vec3(1., 0., 0.)], 1);
+        quad(
+            &mut s,
+            [
+                vec3(0., 0., 0.),
+                vec3(0., 0., 1.),
+                vec3(1., 0., 1.),
+                vec3(1., 0., 0.),
+            ],
+            1,
+        );
     }
     s
 }
@@ -95,11 +122,17 @@ fn form_factors_match_closed_forms() {
         // (stratification only lowers it); 4σ = 1.6e-3.
         let f = form_factor(&scene, &m, &embree, 980_000.0);
         eprintln!("parallel={parallel}: embree F = {f:.5}, exact {exact}");
-        assert!((f - exact).abs() < 1.6e-3, "parallel={parallel}: F = {f}, exact {exact}");
+        assert!(
+            (f - exact).abs() < 1.6e-3,
+            "parallel={parallel}: F = {f}, exact {exact}"
+        );
         // The brute-force oracle on 2·100² rays: σ ≈ 2.8e-3, 4σ = 1.2e-2.
         let brute = BruteForce::new(&m);
         let f = form_factor(&scene, &m, &brute, 20_000.0);
-        assert!((f - exact).abs() < 1.2e-2, "brute, parallel={parallel}: F = {f}");
+        assert!(
+            (f - exact).abs() < 1.2e-2,
+            "brute, parallel={parallel}: F = {f}"
+        );
     }
 }
 
@@ -118,7 +151,11 @@ fn no_ray_escapes_a_closed_box() {
     };
     let sol = run(&scene, &m, &isect, &cfg);
     assert!(sol.stats.rays >= 1_000_000, "rays {}", sol.stats.rays);
-    assert_eq!(sol.stats.energy.escaped, [0.0; 3], "{} rays", sol.stats.rays);
+    assert_eq!(
+        sol.stats.energy.escaped, [0.0; 3],
+        "{} rays",
+        sol.stats.rays
+    );
     assert_eq!(sol.stats.energy.absorbed_back, [0.0; 3]);
     assert!(sol.stats.energy.relative_residual() < 1e-9);
 }
@@ -145,6 +182,14 @@ fn result_does_not_depend_on_thread_count() {
     assert_eq!(one.stats.rays, two.stats.rays);
     assert_eq!(one.b, two.b);
     // And a different seed gives a different (but equally valid) answer.
-    let other = run(&scene, &m, &isect, &SolveConfig { seed: 43, ..cfg.clone() });
+    let other = run(
+        &scene,
+        &m,
+        &isect,
+        &SolveConfig {
+            seed: 43,
+            ..cfg.clone()
+        },
+    );
     assert_ne!(one.b, other.b);
 }

@@ -1,0 +1,248 @@
+//! The `radiosity` command as a user meets it: outputs of a solve, and every kind of bad input
+//! giving one line naming the file and the problem, exit code 2, never a panic.
+
+use assert_cmd::Command;
+use std::path::Path;
+
+fn radiosity() -> Command {
+    let mut c = Command::cargo_bin("radiosity").unwrap();
+    c.env_remove("RUST_BACKTRACE");
+    c
+}
+
+/// Runs and returns (exit code, stdout, stderr).
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = radiosity().args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A bad-input failure: exit code 2, no panic, and an error line naming `needle`.
+fn assert_user_error(args: &[&str], needles: &[&str]) {
+    let (code, _, err) = run(args);
+    assert_eq!(code, 2, "args {args:?}: stderr {err}");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("Error:") || l.starts_with("error:"))
+        .unwrap_or_else(|| panic!("no error line in {err}"));
+    for n in needles {
+        assert!(
+            line.to_lowercase().contains(&n.to_lowercase()),
+            "'{n}' not in error line '{line}'"
+        );
+    }
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
+const LIT_MTL: &str = "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 5 5 5\n";
+/// A floor with a lamp above it, facing down.
+const LIT_OBJ: &str = "mtllib m.mtl\n\
+v 0 0 0\nv 0 0 1\nv 1 0 1\nv 1 0 0\n\
+v 0.4 1 0.4\nv 0.6 1 0.4\nv 0.6 1 0.6\nv 0.4 1 0.6\n\
+usemtl white\nf 1 2 3 4\nusemtl lamp\nf 5 6 7 8\n";
+
+#[test]
+fn solve_default_scene_writes_the_three_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    let (code, stdout, err) = run(&["solve", "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("patches"), "{stdout}");
+    let csv = std::fs::read_to_string(out.join("patches.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "id,cx,cy,cz,nx,ny,nz,area,rho_r,rho_g,rho_b,e_r,e_g,e_b,b_r,b_g,b_b"
+    );
+    let rows: Vec<&str> = lines.collect();
+    assert!(rows.len() > 100);
+    assert!(!csv.contains("NaN") && !csv.contains("inf"));
+    let png = image::open(out.join("render.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (640, 480));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(json["patches"].as_u64().unwrap() as usize, rows.len());
+    assert!(json["energy"]["relative_residual"].as_f64().unwrap() < 1e-9);
+    assert_eq!(json["stop_reason"], "converged");
+    assert!(json["trace"].as_array().unwrap().len() >= 2);
+    for phase in ["load", "mesh", "build", "solve", "output", "total"] {
+        assert!(json["seconds"][phase].as_f64().is_some(), "{phase}");
+    }
+}
+
+#[test]
+fn info_describes_the_default_scene() {
+    let (code, stdout, err) = run(&["info"]);
+    assert_eq!(code, 0, "{err}");
+    for word in [
+        "polygons",
+        "patches",
+        "axis-aligned",
+        "lights",
+        "bounds",
+        "suggested",
+    ] {
+        assert!(stdout.contains(word), "{word} missing from {stdout}");
+    }
+}
+
+#[test]
+fn missing_file() {
+    assert_user_error(&["solve", "/nonexistent/room.obj"], &["room.obj"]);
+    assert_user_error(&["info", "/nonexistent/room.obj"], &["room.obj"]);
+}
+
+#[test]
+fn unparsable_obj() {
+    let d = tempfile::tempdir().unwrap();
+    let f = write(
+        d.path(),
+        "bad.obj",
+        "v 1 2 banana\nv 0 0 0\nv 1 0 0\nf 1 2 3\n",
+    );
+    assert_user_error(&["info", &f], &["bad.obj"]);
+}
+
+#[test]
+fn missing_mtl_is_a_warning_and_a_default_grey() {
+    let d = tempfile::tempdir().unwrap();
+    let f = write(
+        d.path(),
+        "nomtl.obj",
+        &LIT_OBJ.replace("m.mtl", "absent.mtl"),
+    );
+    let (code, stdout, err) = run(&["info", &f]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        (stdout + &err).to_lowercase().contains("absent.mtl"),
+        "the warning names the missing file"
+    );
+}
+
+#[test]
+fn nan_or_infinite_coordinates() {
+    let d = tempfile::tempdir().unwrap();
+    for (name, v) in [("nan.obj", "nan"), ("inf.obj", "inf")] {
+        let f = write(
+            d.path(),
+            name,
+            &format!("v {v} 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
+        );
+        assert_user_error(&["info", &f], &[name]);
+    }
+}
+
+#[test]
+fn face_with_fewer_than_three_vertices() {
+    let d = tempfile::tempdir().unwrap();
+    let f = write(
+        d.path(),
+        "two.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n",
+    );
+    assert_user_error(&["info", &f], &["two.obj"]);
+}
+
+#[test]
+fn zero_area_faces_are_dropped_with_one_warning() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "m.mtl", LIT_MTL);
+    let degenerate = "v 5 5 5\nv 6 6 6\nv 7 7 7\nusemtl white\nf 9 10 11\nf 9 10 11\n";
+    let f = write(d.path(), "zero.obj", &format!("{LIT_OBJ}{degenerate}"));
+    let out = d.path().join("o");
+    let (code, _, err) = run(&[
+        "solve",
+        &f,
+        "--out",
+        out.to_str().unwrap(),
+        "--patch-size",
+        "0.25",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let warnings: Vec<&str> = err.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(warnings.len(), 1, "{err}");
+    assert!(
+        warnings[0].contains('2'),
+        "counts the 2 dropped faces: {}",
+        warnings[0]
+    );
+}
+
+#[test]
+fn reflectance_outside_zero_one() {
+    let d = tempfile::tempdir().unwrap();
+    write(
+        d.path(),
+        "m.mtl",
+        &LIT_MTL.replace("Kd 0.5 0.5 0.5\nnewmtl", "Kd 1.2 0.5 0.5\nnewmtl"),
+    );
+    let f = write(d.path(), "rho.obj", LIT_OBJ);
+    assert_user_error(&["info", &f], &["white"]);
+}
+
+#[test]
+fn no_emitter_suggests_emit() {
+    let d = tempfile::tempdir().unwrap();
+    write(
+        d.path(),
+        "m.mtl",
+        "newmtl white\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\n",
+    );
+    let f = write(d.path(), "dark.obj", LIT_OBJ);
+    let out = d.path().join("o");
+    assert_user_error(
+        &["solve", &f, "--out", out.to_str().unwrap()],
+        &["dark.obj", "--emit"],
+    );
+    // ... and --emit fixes it.
+    let (code, _, err) = run(&[
+        "solve",
+        &f,
+        "--out",
+        out.to_str().unwrap(),
+        "--emit",
+        "lamp=5,5,5",
+        "-q",
+    ]);
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
+fn unwritable_output_folder() {
+    let d = tempfile::tempdir().unwrap();
+    let file = write(d.path(), "plain-file", "x");
+    let out = format!("{file}/sub");
+    assert_user_error(&["solve", "--out", &out], &["plain-file"]);
+}
+
+#[test]
+fn bad_flag_values() {
+    let d = tempfile::tempdir().unwrap();
+    let out = d.path().join("o");
+    let out = out.to_str().unwrap();
+    for (flag, value, needle) in [
+        ("--tolerance", "2", "--tolerance"),
+        ("--tolerance", "0", "--tolerance"),
+        ("--patch-size", "-1", "--patch-size"),
+        ("--stop", "0", "--stop"),
+        ("--max-time", "-3", "--max-time"),
+        ("--fov", "200", "--fov"),
+        ("--width", "0", "--width"),
+        ("--emit", "lamp", "--emit"),
+        ("--emit", "lamp=1,2", "--emit"),
+        ("--emit", "nosuchmaterial=1,1,1", "nosuchmaterial"),
+        ("--seed", "x", "--seed"),
+        ("--eye", "1,2", "--eye"),
+    ] {
+        assert_user_error(&["solve", "--out", out, flag, value], &[needle]);
+    }
+}
