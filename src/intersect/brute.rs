@@ -7,6 +7,7 @@ use glam::Vec3;
 
 pub struct BruteForce {
     tris: Vec<([Vec3; 3], u32)>,
+    normals: Vec<Vec3>,
 }
 
 impl BruteForce {
@@ -15,7 +16,8 @@ impl BruteForce {
             .triangles()
             .map(|(t, p)| (t.map(|v| mesh.vertices[v as usize]), p))
             .collect();
-        BruteForce { tris }
+        let normals = mesh.patches.iter().map(|p| p.normal).collect();
+        BruteForce { tris, normals }
     }
 }
 
@@ -56,7 +58,11 @@ impl Intersector for BruteForce {
                 }
             }
         }
-        best.map(|(t, patch)| Hit { patch, t: t as f32 })
+        best.map(|(t, patch)| Hit {
+            patch,
+            t: t as f32,
+            back: self.normals[patch as usize].dot(ray.dir) > 0.0,
+        })
     }
 
     fn name(&self) -> &'static str {

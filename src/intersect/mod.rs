@@ -19,11 +19,13 @@ pub struct Ray {
     pub tfar: f32,
 }
 
-/// The closest patch a ray meets, and where.
+/// The closest patch a ray meets, where, and from which side.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
     pub patch: u32,
     pub t: f32,
+    /// The ray met the patch's back face (the side its normal points away from).
+    pub back: bool,
 }
 
 /// Closest-hit ray queries over a fixed set of patches. `Sync` so rayon threads share one.

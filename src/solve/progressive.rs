@@ -29,7 +29,7 @@ use std::collections::BinaryHeap;
 use std::time::Instant;
 
 /// Rays per wave of shots (see the module docs). Fixed, so results do not depend on threads.
-pub const WAVE_RAYS: usize = 16_384;
+pub const WAVE_RAYS: usize = 32_768;
 /// Rays per parallel task.
 const CHUNK: usize = 1024;
 /// Hit codes: a patch id, a patch id with this bit for a back-face hit, or [`ESCAPED`].
@@ -141,29 +141,44 @@ fn rng_for(seed: u64, shot: u64, chunk: u64) -> Pcg64 {
     Pcg64::seed_from_u64(mix(mix(mix(seed) ^ shot) ^ chunk))
 }
 
-/// A point uniform over the area of convex patch `i` (fan triangles chosen by area).
-fn point_on_patch<R: Rng>(mesh: &Mesh, i: usize, rng: &mut R) -> Vec3 {
-    let ids = mesh.patch_indices(i);
-    let v = |k: usize| mesh.vertices[ids[k] as usize];
-    let a = v(0);
-    let mut k = 1;
-    if ids.len() > 3 {
-        let areas: Vec<f32> = (1..ids.len() - 1)
-            .map(|k| (v(k) - a).cross(v(k + 1) - a).length())
+/// Draws points uniformly over the area of one convex patch: a fan triangle chosen by area,
+/// then a uniform point in it. Built once per chunk of rays, so no work per ray but the draw.
+struct PatchPoints {
+    apex: Vec3,
+    /// (b, c, cumulative area) of each fan triangle (apex, b, c).
+    fan: Vec<(Vec3, Vec3, f32)>,
+}
+
+impl PatchPoints {
+    fn new(mesh: &Mesh, i: usize) -> PatchPoints {
+        let ids = mesh.patch_indices(i);
+        let v = |k: usize| mesh.vertices[ids[k] as usize];
+        let apex = v(0);
+        let mut total = 0.0;
+        let fan = (1..ids.len() - 1)
+            .map(|k| {
+                total += (v(k) - apex).cross(v(k + 1) - apex).length();
+                (v(k), v(k + 1), total)
+            })
             .collect();
-        let total: f32 = areas.iter().sum();
-        let mut u = rng.gen::<f32>() * total;
-        for (q, &ar) in areas.iter().enumerate() {
-            k = q + 1;
-            if u < ar {
-                break;
-            }
-            u -= ar;
-        }
+        PatchPoints { apex, fan }
     }
-    let (b, c) = (v(k), v(k + 1));
-    let (r1, r2) = (rng.gen::<f32>().sqrt(), rng.gen::<f32>());
-    a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
+
+    #[inline]
+    fn sample<R: Rng>(&self, rng: &mut R) -> Vec3 {
+        let (mut b, mut c, _) = self.fan[0];
+        if self.fan.len() > 1 {
+            let u = rng.gen::<f32>() * self.fan[self.fan.len() - 1].2;
+            let k = self
+                .fan
+                .iter()
+                .position(|f| u < f.2)
+                .unwrap_or(self.fan.len() - 1);
+            (b, c) = (self.fan[k].0, self.fan[k].1);
+        }
+        let (r1, r2) = (rng.gen::<f32>().sqrt(), rng.gen::<f32>());
+        self.apex * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
+    }
 }
 
 /// Everything a shot needs to know about the scene, shared by all threads.
@@ -186,10 +201,11 @@ impl<I: Intersector> Ctx<'_, I> {
         let frame = Frame::new(patch.normal, angle);
         let mut rng = rng_for(self.seed, shot.index, chunk as u64);
         let eps = (1e-4 * (patch.area as f32).sqrt()).max(self.eps_floor);
+        let points = PatchPoints::new(self.mesh, i);
         let mut out = Vec::with_capacity(count);
         for k in first..first + count {
             let dir = frame.to_world(shot.grid.direction(k, 0.0, self.jitter, &mut rng));
-            let org = point_on_patch(self.mesh, i, &mut rng) + patch.normal * eps;
+            let org = points.sample(&mut rng) + patch.normal * eps;
             out.push(self.trace(i, org, dir, eps));
         }
         out
@@ -208,22 +224,158 @@ impl<I: Intersector> Ctx<'_, I> {
             match self.isect.intersect(&ray) {
                 None => return ESCAPED,
                 Some(h) if h.patch as usize == shooter => ray.tnear = h.t + eps,
-                Some(h) => {
-                    let n = self.mesh.patches[h.patch as usize].normal;
-                    return if n.dot(dir) > 0.0 {
-                        h.patch | BACK
-                    } else {
-                        h.patch
-                    };
-                }
+                Some(h) if h.back => return h.patch | BACK,
+                Some(h) => return h.patch,
             }
         }
         ESCAPED
     }
 }
 
-/// Solves by progressive refinement. `on_wave` is called after every wave with the latest
-/// trace point (for progress display).
+/// Per-patch solver state, packed so applying a hit touches one place in memory.
+#[derive(Clone, Copy, Debug)]
+struct PatchState {
+    /// Unshot flux ΔΦ_j (W).
+    unshot: [f64; 3],
+    /// Radiosity B_j (W/m²).
+    b: [f64; 3],
+    rho: [f64; 3],
+    area: f64,
+}
+
+/// The solver's mutable state: patches, heaps and energy accounts.
+struct State {
+    patches: Vec<PatchState>,
+    by_flux: LazyHeap,
+    by_b: LazyHeap,
+    energy: EnergyBalance,
+    /// Σ B_j·A_j, for the mean radiosity.
+    b_flux: [f64; 3],
+    touched: Vec<bool>,
+    touched_list: Vec<u32>,
+    rays: u64,
+    stop_fraction: f64,
+    total_area: f64,
+}
+
+impl State {
+    #[inline]
+    fn key_flux(&self, i: usize) -> f64 {
+        scalar(&self.patches[i].unshot)
+    }
+    #[inline]
+    fn key_b(&self, i: usize) -> f64 {
+        scalar(&self.patches[i].unshot) / self.patches[i].area
+    }
+
+    /// Max unshot radiosity (scalar) over all patches, from the heap.
+    fn max_unshot_b(&mut self) -> f64 {
+        let patches = &self.patches;
+        self.by_b
+            .peek(|i| scalar(&patches[i].unshot) / patches[i].area)
+            .map_or(0.0, |e| e.0)
+    }
+
+    /// Takes the patch with the most unshot flux off the heap, if any.
+    fn pop_shooter(&mut self) -> Option<(usize, f64)> {
+        let patches = &self.patches;
+        let top = self.by_flux.peek(|i| scalar(&patches[i].unshot))?;
+        self.by_flux.heap.pop();
+        Some((top.1 as usize, top.0))
+    }
+
+    /// Applies a wave's hits in task order: receivers gain ρ_j·ΔΦ_i/X, the rest is absorbed.
+    fn apply(&mut self, wave: &[Shot], tasks: &[Task], hits: &[Vec<u32>]) {
+        for (task, codes) in tasks.iter().zip(hits) {
+            let shot = &wave[task.shot];
+            let phi_ray = shot.phi.map(|p| p / shot.grid.len() as f64);
+            for &code in codes {
+                if code == ESCAPED {
+                    add3(&mut self.energy.escaped, &phi_ray);
+                } else if code & BACK != 0 {
+                    add3(&mut self.energy.absorbed_back, &phi_ray);
+                } else {
+                    let j = code as usize;
+                    let p = &mut self.patches[j];
+                    let inv_area = 1.0 / p.area;
+                    for c in 0..3 {
+                        let kept = p.rho[c] * phi_ray[c];
+                        p.unshot[c] += kept;
+                        p.b[c] += kept * inv_area;
+                        self.b_flux[c] += kept;
+                        self.energy.absorbed[c] += phi_ray[c] - kept;
+                    }
+                    if !self.touched[j] {
+                        self.touched[j] = true;
+                        self.touched_list.push(code);
+                    }
+                }
+            }
+            self.rays += codes.len() as u64;
+        }
+        // New heap entries for every patch whose unshot energy grew. The max-ΔB heap only
+        // needs patches that could block convergence: the threshold f·mean(B) never falls
+        // (B only grows), so a patch below it now matters again only once it grows, and then
+        // it is pushed again.
+        let threshold = self.stop_fraction * scalar(&self.b_flux) / self.total_area;
+        let list = std::mem::take(&mut self.touched_list);
+        for &j in &list {
+            let j = j as usize;
+            self.touched[j] = false;
+            let (kf, kb) = (self.key_flux(j), self.key_b(j));
+            self.by_flux.push(kf, j);
+            if kb >= threshold {
+                self.by_b.push(kb, j);
+            }
+        }
+        self.touched_list = list;
+        self.touched_list.clear();
+        let n = self.patches.len();
+        let patches = &self.patches;
+        self.by_flux.compact(n, |i| scalar(&patches[i].unshot));
+        self.by_b
+            .compact(n, |i| scalar(&patches[i].unshot) / patches[i].area);
+    }
+}
+
+/// A chunk of one shot's rays: the unit of parallel work.
+#[derive(Clone, Copy, Debug)]
+struct Task {
+    shot: usize,
+    chunk: usize,
+    first: usize,
+    count: usize,
+}
+
+/// A wave cast but not yet applied.
+struct Pending {
+    wave: Vec<Shot>,
+    tasks: Vec<Task>,
+    hits: Vec<Vec<u32>>,
+}
+
+fn tasks_of(wave: &[Shot]) -> Vec<Task> {
+    wave.iter()
+        .enumerate()
+        .flat_map(|(s, shot)| {
+            let x = shot.grid.len();
+            (0..x.div_ceil(CHUNK)).map(move |c| Task {
+                shot: s,
+                chunk: c,
+                first: c * CHUNK,
+                count: CHUNK.min(x - c * CHUNK),
+            })
+        })
+        .collect()
+}
+
+/// Solves by progressive refinement. `on_wave` is called with each new trace point (for
+/// progress display).
+///
+/// Waves are pipelined: while one thread applies wave k's hits, the others cast wave k + 1,
+/// which was taken off the heap before wave k's deposits reached it. Its shooters are then
+/// at most one wave out of date; the energy books stay exact and the order stays fixed, so the
+/// result is still the same on any thread count.
 pub fn solve<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
@@ -236,36 +388,54 @@ pub fn solve<I: Intersector>(
     if n >= BACK as usize {
         return Err(SolveError::TooManyPatches(n));
     }
-    let rho: Vec<[f64; 3]> = mesh
+    let patches: Vec<PatchState> = mesh
         .patches
         .iter()
-        .map(|p| materials[p.material as usize].rho)
+        .map(|p| {
+            let m = &materials[p.material as usize];
+            let e = m.emission();
+            PatchState {
+                unshot: e.map(|x| x * p.area),
+                b: e,
+                rho: m.rho,
+                area: p.area,
+            }
+        })
         .collect();
-    let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
-    let mut b: Vec<[f64; 3]> = mesh
-        .patches
-        .iter()
-        .map(|p| materials[p.material as usize].emission())
-        .collect();
-    let mut unshot: Vec<[f64; 3]> = b.iter().zip(&area).map(|(e, a)| e.map(|x| x * a)).collect();
-    let mut energy = EnergyBalance::default();
-    for u in &unshot {
-        add3(&mut energy.emitted, u);
+    let mut st = State {
+        patches,
+        by_flux: LazyHeap {
+            heap: BinaryHeap::new(),
+        },
+        by_b: LazyHeap {
+            heap: BinaryHeap::new(),
+        },
+        energy: EnergyBalance::default(),
+        b_flux: [0.0; 3],
+        touched: vec![false; n],
+        touched_list: Vec::new(),
+        rays: 0,
+        stop_fraction: cfg.stop_fraction,
+        total_area: mesh.total_area(),
+    };
+    for i in 0..n {
+        let p = st.patches[i];
+        add3(&mut st.energy.emitted, &p.unshot);
+        add3(&mut st.b_flux, &p.unshot);
+        let (kf, kb) = (st.key_flux(i), st.key_b(i));
+        st.by_flux.push(kf, i);
+        st.by_b.push(kb, i);
     }
-    if scalar(&energy.emitted) <= 0.0 {
+    if scalar(&st.energy.emitted) <= 0.0 {
         return Err(SolveError::NoEmitter);
     }
+    let rho: Vec<[f64; 3]> = st.patches.iter().map(|p| p.rho).collect();
     let c_ray = cfg
         .energy_per_ray
         .filter(|c| *c > 0.0)
-        .unwrap_or_else(|| energy_per_ray(mesh, &rho, scalar(&energy.emitted), cfg.tolerance));
-    let total_area: f64 = area.iter().sum();
-    let mut b_flux = [0.0f64; 3]; // Σ B_i A_i, for the mean radiosity
-    for (bi, a) in b.iter().zip(&area) {
-        for c in 0..3 {
-            b_flux[c] += bi[c] * a;
-        }
-    }
+        .unwrap_or_else(|| energy_per_ray(mesh, &rho, scalar(&st.energy.emitted), cfg.tolerance));
+    drop(rho);
+    let total_area: f64 = st.patches.iter().map(|p| p.area).sum();
 
     let (lo, hi) = mesh.vertices.iter().fold(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
@@ -280,146 +450,124 @@ pub fn solve<I: Intersector>(
         eps_floor: reach * 5e-7,
     };
 
-    let key_flux = |u: &[[f64; 3]], i: usize| scalar(&u[i]);
-    let key_b = |u: &[[f64; 3]], i: usize| scalar(&u[i]) / area[i];
-    let mut by_flux = LazyHeap {
-        heap: BinaryHeap::new(),
-    };
-    let mut by_b = LazyHeap {
-        heap: BinaryHeap::new(),
-    };
-    for i in 0..n {
-        by_flux.push(key_flux(&unshot, i), i);
-        by_b.push(key_b(&unshot, i), i);
-    }
-
     let mut stats = SolveStats {
         energy_per_ray: c_ray,
         ..SolveStats::default()
     };
-    let mut touched = vec![false; n];
-    let mut touched_list: Vec<usize> = Vec::new();
+    let mut pending: Option<Pending> = None;
     let mut next_trace = 0.0f64;
-    let stop_reason;
-    loop {
+    let stop_reason = loop {
         // Sec. 3's criterion, then the budgets.
-        let max_b = by_b.peek(|i| key_b(&unshot, i)).map_or(0.0, |e| e.0);
-        let mean_b = scalar(&b_flux) / total_area;
+        let max_b = st.max_unshot_b();
+        let mean_b = scalar(&st.b_flux) / total_area;
         let elapsed = start.elapsed().as_secs_f64();
-        let point = TracePoint {
-            time_s: elapsed,
-            shots: stats.shots,
-            rays: stats.rays,
-            max_unshot_b: max_b,
-            mean_b,
-            unshot_flux: 0.0,
-        };
+        let in_flight = pending
+            .as_ref()
+            .map_or(0, |p| p.hits.iter().map(Vec::len).sum::<usize>());
         let reason = if max_b <= 0.0 {
             Some(StopReason::Exhausted)
         } else if max_b < cfg.stop_fraction * mean_b {
             Some(StopReason::Converged)
         } else if cfg.max_time.is_some_and(|t| elapsed >= t.as_secs_f64()) {
             Some(StopReason::MaxTime)
-        } else if cfg.max_rays.is_some_and(|r| stats.rays >= r) {
+        } else if cfg
+            .max_rays
+            .is_some_and(|r| st.rays + in_flight as u64 >= r)
+        {
             Some(StopReason::MaxRays)
         } else {
             None
         };
-        if reason.is_some() || elapsed >= next_trace {
-            let mut p = point;
-            p.unshot_flux = unshot.iter().map(scalar).sum();
-            stats.trace.push(p);
-            next_trace = (elapsed * 1.25).max(elapsed + 0.002);
-            on_wave(&p);
-        }
         if let Some(r) = reason {
-            stop_reason = r;
-            break;
+            // Deposits still in flight may change the verdict: apply them and look again.
+            if let Some(p) = pending.take() {
+                st.apply(&p.wave, &p.tasks, &p.hits);
+                continue;
+            }
+            record(&mut stats, &st, elapsed, max_b, mean_b, &mut on_wave);
+            break r;
+        }
+        if elapsed >= next_trace {
+            record(&mut stats, &st, elapsed, max_b, mean_b, &mut on_wave);
+            next_trace = (elapsed * 1.25).max(elapsed + 0.002);
         }
 
-        // Take a wave of shooters off the top of the heap.
+        // Take a wave of shooters off the top of the heap (Sec. 2: X = ΔΦ_i / C rays each).
         let mut wave: Vec<Shot> = Vec::new();
         let mut wave_rays = 0usize;
-        let ray_cap = cfg
-            .max_rays
-            .map_or(usize::MAX, |r| r.saturating_sub(stats.rays) as usize);
+        let ray_cap = cfg.max_rays.map_or(usize::MAX, |r| {
+            r.saturating_sub(st.rays + in_flight as u64) as usize
+        });
         while wave_rays < WAVE_RAYS.min(ray_cap.max(1)) {
-            let Some(top) = by_flux.peek(|i| key_flux(&unshot, i)) else {
+            let Some((i, key)) = st.pop_shooter() else {
                 break;
             };
-            by_flux.heap.pop();
-            let i = top.1 as usize;
-            let grid = PolarGrid::for_samples(top.0 / c_ray);
+            let grid = PolarGrid::for_samples(key / c_ray);
             wave_rays += grid.len();
             wave.push(Shot {
                 patch: i,
                 index: stats.shots,
-                phi: unshot[i],
+                phi: st.patches[i].unshot,
                 grid,
             });
-            unshot[i] = [0.0; 3];
+            st.patches[i].unshot = [0.0; 3];
             stats.shots += 1;
         }
         if wave.is_empty() {
-            continue; // the heap peek above will report Exhausted
-        }
-
-        // Cast in parallel, in fixed chunks.
-        let tasks: Vec<(usize, usize, usize, usize)> = wave
-            .iter()
-            .enumerate()
-            .flat_map(|(s, shot)| {
-                let x = shot.grid.len();
-                (0..x.div_ceil(CHUNK)).map(move |c| (s, c, c * CHUNK, CHUNK.min(x - c * CHUNK)))
-            })
-            .collect();
-        let hits: Vec<Vec<u32>> = tasks
-            .par_iter()
-            .map(|&(s, c, first, count)| ctx.cast(&wave[s], c, first, count))
-            .collect();
-
-        // Apply in task order: receivers gain ρ_j·ΔΦ_i/X.
-        for (&(s, ..), codes) in tasks.iter().zip(&hits) {
-            let shot = &wave[s];
-            let phi_ray = shot.phi.map(|p| p / shot.grid.len() as f64);
-            for &code in codes {
-                if code == ESCAPED {
-                    add3(&mut energy.escaped, &phi_ray);
-                } else if code & BACK != 0 {
-                    add3(&mut energy.absorbed_back, &phi_ray);
-                } else {
-                    let j = code as usize;
-                    for c in 0..3 {
-                        let kept = rho[j][c] * phi_ray[c];
-                        unshot[j][c] += kept;
-                        b[j][c] += kept / area[j];
-                        b_flux[c] += kept;
-                        energy.absorbed[c] += phi_ray[c] - kept;
-                    }
-                    if !touched[j] {
-                        touched[j] = true;
-                        touched_list.push(j);
-                    }
-                }
+            // Nothing to shoot until the wave in flight lands.
+            if let Some(p) = pending.take() {
+                st.apply(&p.wave, &p.tasks, &p.hits);
             }
-            stats.rays += codes.len() as u64;
+            continue;
         }
-        for &j in &touched_list {
-            touched[j] = false;
-            by_flux.push(key_flux(&unshot, j), j);
-            by_b.push(key_b(&unshot, j), j);
-        }
-        touched_list.clear();
-        by_flux.compact(n, |i| key_flux(&unshot, i));
-        by_b.compact(n, |i| key_b(&unshot, i));
-        stats.waves += 1;
-    }
 
-    for u in &unshot {
-        add3(&mut energy.unshot, u);
+        // Cast this wave in parallel while the previous one is applied.
+        let tasks = tasks_of(&wave);
+        let cast = || -> Vec<Vec<u32>> {
+            tasks
+                .par_iter()
+                .map(|t| ctx.cast(&wave[t.shot], t.chunk, t.first, t.count))
+                .collect()
+        };
+        let hits = match pending.take() {
+            Some(p) => rayon::join(|| st.apply(&p.wave, &p.tasks, &p.hits), cast).1,
+            None => cast(),
+        };
+        pending = Some(Pending { wave, tasks, hits });
+        stats.waves += 1;
+    };
+
+    for p in &st.patches {
+        add3(&mut st.energy.unshot, &p.unshot);
     }
-    stats.energy = energy;
+    stats.rays = st.rays;
+    stats.energy = st.energy;
     stats.stop_reason = Some(stop_reason);
     stats.seconds = start.elapsed().as_secs_f64();
-    Ok(Solution { b, unshot, stats })
+    Ok(Solution {
+        b: st.patches.iter().map(|p| p.b).collect(),
+        unshot: st.patches.iter().map(|p| p.unshot).collect(),
+        stats,
+    })
+}
+
+/// Adds a trace point (and tells the caller).
+fn record(
+    stats: &mut SolveStats,
+    st: &State,
+    elapsed: f64,
+    max_b: f64,
+    mean_b: f64,
+    on_wave: &mut impl FnMut(&TracePoint),
+) {
+    let p = TracePoint {
+        time_s: elapsed,
+        shots: stats.shots,
+        rays: st.rays,
+        max_unshot_b: max_b,
+        mean_b,
+        unshot_flux: st.patches.iter().map(|p| scalar(&p.unshot)).sum(),
+    };
+    stats.trace.push(p);
+    on_wave(&p);
 }
