@@ -276,6 +276,12 @@ impl State {
             .map_or(0.0, |e| e.0)
     }
 
+    /// Is any unshot energy left?
+    fn has_unshot(&mut self) -> bool {
+        let patches = &self.patches;
+        self.by_flux.peek(|i| scalar(&patches[i].unshot)).is_some()
+    }
+
     /// Takes the patch with the most unshot flux off the heap, if any.
     fn pop_shooter(&mut self) -> Option<(usize, f64)> {
         let patches = &self.patches;
@@ -298,12 +304,12 @@ impl State {
                     let j = code as usize;
                     let p = &mut self.patches[j];
                     let inv_area = 1.0 / p.area;
-                    for c in 0..3 {
-                        let kept = p.rho[c] * phi_ray[c];
+                    for (c, &phi) in phi_ray.iter().enumerate() {
+                        let kept = p.rho[c] * phi;
                         p.unshot[c] += kept;
                         p.b[c] += kept * inv_area;
                         self.b_flux[c] += kept;
-                        self.energy.absorbed[c] += phi_ray[c] - kept;
+                        self.energy.absorbed[c] += phi - kept;
                     }
                     if !self.touched[j] {
                         self.touched[j] = true;
@@ -464,10 +470,14 @@ pub fn solve<I: Intersector>(
         let in_flight = pending
             .as_ref()
             .map_or(0, |p| p.hits.iter().map(Vec::len).sum::<usize>());
-        let reason = if max_b <= 0.0 {
-            Some(StopReason::Exhausted)
-        } else if max_b < cfg.stop_fraction * mean_b {
-            Some(StopReason::Converged)
+        let reason = if max_b < cfg.stop_fraction * mean_b {
+            // The max-ΔB heap holds only patches above the threshold; whether any energy at
+            // all is left, the flux heap says.
+            if st.has_unshot() {
+                Some(StopReason::Converged)
+            } else {
+                Some(StopReason::Exhausted)
+            }
         } else if cfg.max_time.is_some_and(|t| elapsed >= t.as_secs_f64()) {
             Some(StopReason::MaxTime)
         } else if cfg
@@ -560,11 +570,18 @@ fn record(
     mean_b: f64,
     on_wave: &mut impl FnMut(&TracePoint),
 ) {
+    // The heap knows the max only above the stop threshold; a trace point is rare enough to
+    // scan for the exact value.
+    let exact_max = st
+        .patches
+        .iter()
+        .map(|p| scalar(&p.unshot) / p.area)
+        .fold(max_b, f64::max);
     let p = TracePoint {
         time_s: elapsed,
         shots: stats.shots,
         rays: st.rays,
-        max_unshot_b: max_b,
+        max_unshot_b: exact_max,
         mean_b,
         unshot_flux: st.patches.iter().map(|p| scalar(&p.unshot)).sum(),
     };
