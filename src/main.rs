@@ -312,13 +312,15 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 rays,
             )?;
             println!(
-                "{}: {} triangles, {} patches, {} threads\n  raw Embree closest hit: {:.2} Mrays/s ({} rays)\n  solver:                 {:.2} Mrays/s ({} rays)\n  solver / raw:           {:.0} %",
+                "{}: {} triangles, {} patches, {} threads\n  raw Embree closest hit: {:.2} Mrays/s ({} rays; {:.2} before, {:.2} after the solve)\n  solver:                 {:.2} Mrays/s ({} rays)\n  solver / raw:           {:.0} %",
                 b.scene,
                 b.triangles,
                 b.patches,
                 b.threads,
                 b.raw_rays_per_second / 1e6,
                 b.raw_rays,
+                b.raw_before_after[0] / 1e6,
+                b.raw_before_after[1] / 1e6,
                 b.solver_rays_per_second / 1e6,
                 b.solver_rays,
                 100.0 * b.ratio

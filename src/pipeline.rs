@@ -286,6 +286,8 @@ pub struct RayBench {
     /// directions uniform on the sphere), all threads.
     pub raw_rays_per_second: f64,
     pub raw_rays: u64,
+    /// The raw rate measured before and after the solve.
+    pub raw_before_after: [f64; 2],
     /// Rays per second of the solver's whole solve phase (sampling, casting, bookkeeping).
     pub solver_rays_per_second: f64,
     pub solver_rays: u64,
@@ -342,14 +344,17 @@ pub fn bench_rays(
     let m = mesh::build(&scene, mesh_opts);
     let isect = EmbreeScene::build(&m, |_| true)?;
     let (lo, hi) = scene.bounds();
-    // Warm up (page in the BVH, spin up the threads), then measure.
+    // Warm up (page in the BVH, spin up the threads), then measure the raw rate before and
+    // after the solve, so a drift of the machine's speed shows and averages out.
     raw_throughput(&isect, lo, hi, raw_rays / 10 + 1, cfg.seed);
-    let (n_raw, s_raw) = raw_throughput(&isect, lo, hi, raw_rays, cfg.seed);
+    let (n1, s1) = raw_throughput(&isect, lo, hi, raw_rays / 2, cfg.seed);
     let sol =
         solve::solve(&m, &scene.materials, &isect, cfg, |_| {}).map_err(|source| Error::Solve {
             scene: scene.name.clone(),
             source,
         })?;
+    let (n2, s2) = raw_throughput(&isect, lo, hi, raw_rays / 2, cfg.seed ^ 1);
+    let (n_raw, s_raw) = (n1 + n2, s1 + s2);
     let raw = n_raw as f64 / s_raw.max(1e-9);
     let solver = sol.stats.rays as f64 / sol.stats.seconds.max(1e-9);
     Ok(RayBench {
@@ -359,6 +364,7 @@ pub fn bench_rays(
         threads: rayon::current_num_threads(),
         raw_rays_per_second: raw,
         raw_rays: n_raw,
+        raw_before_after: [n1 as f64 / s1.max(1e-9), n2 as f64 / s2.max(1e-9)],
         solver_rays_per_second: solver,
         solver_rays: sol.stats.rays,
         ratio: solver / raw,

@@ -1,8 +1,11 @@
 //! Closest-hit queries through Intel Embree 4 (DESIGN.md §3).
 //!
-//! The only module allowed `unsafe`: it calls `embree4-sys` directly, because `embree4-rs`
-//! polls `rtcGetDeviceError` after every ray and hides the scene handle that `rtcIntersect1`
-//! needs. Patches are fanned into triangles; `prim_patch` maps Embree's primitive ids back.
+//! The only module allowed `unsafe`: it calls `embree4-sys` directly. `embree4-rs` 0.0.16 was
+//! tried and dropped: it polls `rtcGetDeviceError` after every ray, hides the scene handle that
+//! `rtcIntersect1` needs, and — measured here — its `intersect_1` is unsound against Embree
+//! 4.3+: the library writes `instPrimID` (4 bytes, seen as 0xffffffff) past the end of the
+//! `RTCRayHit` laid out from the 4.2 headers, i.e. past its stack variable. [`RayHitSlack`]
+//! gives that write somewhere to land. Patches are fanned into triangles; `prim_patch` maps Embree's primitive ids back.
 //! The scene is built with `RTC_SCENE_FLAG_ROBUST` so rays do not slip through shared edges of a
 //! closed room (measured: without it, a few rays per million escape a closed box).
 #![allow(unsafe_code)]
