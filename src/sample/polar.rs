@@ -49,18 +49,19 @@ impl PolarGrid {
         let t = self.theta_divisions() as usize;
         let (ring, sector) = (k / t, k % t);
         let (du, dv) = if jitter {
-            (rng.gen::<f64>(), rng.gen::<f64>())
+            (rng.gen::<f32>(), rng.gen::<f32>())
         } else {
             (0.5, 0.5)
         };
         // Sec. 2: radius divisions spaced by sqrt so each ring has the same area; a point
         // uniform in area within the ring has r² uniform between the ring's bounds.
-        let r2 = (ring as f64 + du) / self.r as f64;
-        let theta = (sector as f64 + dv) / t as f64 * std::f64::consts::TAU + rotation as f64;
+        let r2 = ((ring as f32 + du) / self.r as f32).min(1.0);
+        let theta = (sector as f32 + dv) / t as f32 * std::f32::consts::TAU + rotation;
         let r = r2.sqrt();
+        let (sin, cos) = theta.sin_cos();
         // Nusselt analog: lift (x, y) to the hemisphere.
         let z = (1.0 - r2).max(0.0).sqrt();
-        Vec3::new((r * theta.cos()) as f32, (r * theta.sin()) as f32, z as f32)
+        Vec3::new(r * cos, r * sin, z)
     }
 
     /// The cell's area on the unit disc (π/X for every cell: the check that the rings are right).

@@ -22,7 +22,7 @@ use crate::sample::{polar::PolarGrid, Frame};
 use crate::scene::Material;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use rand_pcg::Pcg64;
+use rand_pcg::Pcg64Mcg;
 use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
@@ -137,8 +137,8 @@ fn mix(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-fn rng_for(seed: u64, shot: u64, chunk: u64) -> Pcg64 {
-    Pcg64::seed_from_u64(mix(mix(mix(seed) ^ shot) ^ chunk))
+fn rng_for(seed: u64, shot: u64, chunk: u64) -> Pcg64Mcg {
+    Pcg64Mcg::seed_from_u64(mix(mix(mix(seed) ^ shot) ^ chunk))
 }
 
 /// Draws points uniformly over the area of one convex patch: a fan triangle chosen by area,
@@ -232,15 +232,18 @@ impl<I: Intersector> Ctx<'_, I> {
     }
 }
 
-/// Per-patch solver state, packed so applying a hit touches one place in memory.
+/// Per-patch solver state, packed into one cache line so applying a hit costs one miss.
+/// Energies are f64; ρ and 1/A are stored as f32 (exact enough for a reflectance, and the
+/// energy books stay exact because what is absorbed is computed as Φ − ρΦ in f64).
 #[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
 struct PatchState {
     /// Unshot flux ΔΦ_j (W).
     unshot: [f64; 3],
-    /// Radiosity B_j (W/m²).
-    b: [f64; 3],
-    rho: [f64; 3],
-    area: f64,
+    /// Flux received and kept (ρ_j × what arrived), W: B_j = E_j + gathered/A_j.
+    gathered: [f64; 3],
+    rho: [f32; 3],
+    inv_area: f32,
 }
 
 /// The solver's mutable state: patches, heaps and energy accounts.
@@ -265,14 +268,14 @@ impl State {
     }
     #[inline]
     fn key_b(&self, i: usize) -> f64 {
-        scalar(&self.patches[i].unshot) / self.patches[i].area
+        scalar(&self.patches[i].unshot) * self.patches[i].inv_area as f64
     }
 
     /// Max unshot radiosity (scalar) over all patches, from the heap.
     fn max_unshot_b(&mut self) -> f64 {
         let patches = &self.patches;
         self.by_b
-            .peek(|i| scalar(&patches[i].unshot) / patches[i].area)
+            .peek(|i| scalar(&patches[i].unshot) * patches[i].inv_area as f64)
             .map_or(0.0, |e| e.0)
     }
 
@@ -303,11 +306,10 @@ impl State {
                 } else {
                     let j = code as usize;
                     let p = &mut self.patches[j];
-                    let inv_area = 1.0 / p.area;
                     for (c, &phi) in phi_ray.iter().enumerate() {
-                        let kept = p.rho[c] * phi;
+                        let kept = p.rho[c] as f64 * phi;
                         p.unshot[c] += kept;
-                        p.b[c] += kept * inv_area;
+                        p.gathered[c] += kept;
                         self.b_flux[c] += kept;
                         self.energy.absorbed[c] += phi - kept;
                     }
@@ -339,8 +341,9 @@ impl State {
         let n = self.patches.len();
         let patches = &self.patches;
         self.by_flux.compact(n, |i| scalar(&patches[i].unshot));
-        self.by_b
-            .compact(n, |i| scalar(&patches[i].unshot) / patches[i].area);
+        self.by_b.compact(n, |i| {
+            scalar(&patches[i].unshot) * patches[i].inv_area as f64
+        });
     }
 }
 
@@ -402,9 +405,9 @@ pub fn solve<I: Intersector>(
             let e = m.emission();
             PatchState {
                 unshot: e.map(|x| x * p.area),
-                b: e,
-                rho: m.rho,
-                area: p.area,
+                gathered: [0.0; 3],
+                rho: m.rho.map(|r| r as f32),
+                inv_area: (1.0 / p.area) as f32,
             }
         })
         .collect();
@@ -435,13 +438,17 @@ pub fn solve<I: Intersector>(
     if scalar(&st.energy.emitted) <= 0.0 {
         return Err(SolveError::NoEmitter);
     }
-    let rho: Vec<[f64; 3]> = st.patches.iter().map(|p| p.rho).collect();
+    let rho: Vec<[f64; 3]> = mesh
+        .patches
+        .iter()
+        .map(|p| materials[p.material as usize].rho)
+        .collect();
     let c_ray = cfg
         .energy_per_ray
         .filter(|c| *c > 0.0)
         .unwrap_or_else(|| energy_per_ray(mesh, &rho, scalar(&st.energy.emitted), cfg.tolerance));
     drop(rho);
-    let total_area: f64 = st.patches.iter().map(|p| p.area).sum();
+    let total_area = mesh.total_area();
 
     let (lo, hi) = mesh.vertices.iter().fold(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
@@ -555,7 +562,15 @@ pub fn solve<I: Intersector>(
     stats.stop_reason = Some(stop_reason);
     stats.seconds = start.elapsed().as_secs_f64();
     Ok(Solution {
-        b: st.patches.iter().map(|p| p.b).collect(),
+        b: st
+            .patches
+            .iter()
+            .zip(&mesh.patches)
+            .map(|(s, p)| {
+                let e = materials[p.material as usize].emission();
+                [0, 1, 2].map(|c| e[c] + s.gathered[c] / p.area)
+            })
+            .collect(),
         unshot: st.patches.iter().map(|p| p.unshot).collect(),
         stats,
     })
@@ -575,7 +590,7 @@ fn record(
     let exact_max = st
         .patches
         .iter()
-        .map(|p| scalar(&p.unshot) / p.area)
+        .map(|p| scalar(&p.unshot) * p.inv_area as f64)
         .fold(max_b, f64::max);
     let p = TracePoint {
         time_s: elapsed,
