@@ -12,6 +12,7 @@
 
 pub mod error;
 pub mod export;
+pub mod generate;
 pub mod intersect;
 pub mod mesh;
 pub mod pipeline;

@@ -6,7 +6,10 @@
 //! and serves as the test oracle.
 
 pub mod brute;
+pub mod crosscheck;
 pub mod embree;
+pub mod hybrid;
+pub mod plane_merge;
 
 use glam::Vec3;
 

@@ -1,0 +1,1 @@
+//! Generator of architectural models (placeholder: being written).
