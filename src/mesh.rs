@@ -67,7 +67,8 @@ use std::collections::HashMap;
 /// How to cut the scene into patches.
 #[derive(Clone, Debug, Default)]
 pub struct MeshOptions {
-    /// Longest patch edge (metres); `None` derives one from the scene ([`default_patch_size`]).
+    /// Longest patch edge (metres); `None` takes the scene's own hint
+    /// ([`Scene::patch_size_hint`]) or derives one from the scene ([`default_patch_size`]).
     pub patch_size: Option<f32>,
     /// Give every polygon a back patch of its own (thin surfaces seen from both sides).
     pub two_sided: bool,
@@ -129,6 +130,7 @@ pub fn newell(pts: &[Vec3]) -> Vec3 {
 pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
     let size = opts
         .patch_size
+        .or(scene.patch_size_hint)
         .filter(|s| s.is_finite() && *s > 0.0)
         .unwrap_or_else(|| default_patch_size(scene));
     let (lo, hi) = scene.bounds();

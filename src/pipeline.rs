@@ -142,13 +142,17 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
     timings.load = t0.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let suggested = mesh::default_patch_size(&scene);
     let m = mesh::build(&scene, &job.mesh);
     timings.mesh = t.elapsed().as_secs_f64();
     if job.mesh.patch_size.is_none() {
+        let from = if scene.patch_size_hint.is_some() {
+            "the scene file's own"
+        } else {
+            "derived from the scene"
+        };
         log(&format!(
-            "patch size {} m (derived from the scene; --patch-size to change)",
-            suggested
+            "patch size {} m ({from}; --patch-size to change)",
+            m.patch_size
         ));
     }
     log(&format!(

@@ -57,6 +57,9 @@ pub struct Scene {
     pub materials: Vec<Material>,
     /// Non-fatal problems met while loading (missing MTL, dropped zero-area faces, …).
     pub warnings: Vec<String>,
+    /// The patch size the model's author intended, from a comment line
+    /// `# radiosity: patch-size METRES` in the OBJ; used when no `--patch-size` is given.
+    pub patch_size_hint: Option<f32>,
 }
 
 impl Scene {

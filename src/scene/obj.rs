@@ -229,8 +229,33 @@ fn load(name: &str, text: &str, mtl: MtlSource, opts: &LoadOptions) -> Result<Sc
         }
     }
 
+    scene.patch_size_hint = patch_size_hint(text).map_err(fail)?;
     scene.warnings = warnings;
     Ok(scene)
+}
+
+/// The author's patch size: a comment line `# radiosity: patch-size METRES`.
+fn patch_size_hint(text: &str) -> Result<Option<f32>, String> {
+    for (i, line) in text.lines().enumerate() {
+        let Some(rest) = line.trim().strip_prefix('#') else {
+            continue;
+        };
+        let Some(value) = rest.trim().strip_prefix("radiosity:") else {
+            continue;
+        };
+        let Some(value) = value.trim().strip_prefix("patch-size") else {
+            continue;
+        };
+        return match value.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(Some(v)),
+            _ => Err(format!(
+                "line {}: `# radiosity: patch-size` needs a positive length in metres: `{}`",
+                i + 1,
+                snippet(line)
+            )),
+        };
+    }
+    Ok(None)
 }
 
 /// Append one tobj mesh (its own positions, local indices, faces of `face_arities`).
@@ -1369,6 +1394,18 @@ mod tests {
                 &["line 2", needle],
             );
         }
+    }
+
+    #[test]
+    fn patch_size_hint_is_read_from_its_comment() {
+        let obj = "# radiosity: patch-size 0.6\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        let s = load_obj_from_strs("hint.obj", obj, "", &LoadOptions::default()).unwrap();
+        assert_eq!(s.patch_size_hint, Some(0.6));
+        let none = load_obj_from_strs("none.obj", &obj[28..], "", &LoadOptions::default()).unwrap();
+        assert_eq!(none.patch_size_hint, None);
+        let bad = obj.replace("0.6", "-1");
+        let e = load_obj_from_strs("bad.obj", &bad, "", &LoadOptions::default()).unwrap_err();
+        assert!(e.to_string().contains("patch-size"), "{e}");
     }
 
     #[test]
