@@ -246,3 +246,39 @@ fn bad_flag_values() {
         assert_user_error(&["solve", "--out", out, flag, value], &[needle]);
     }
 }
+
+#[test]
+fn flipped_normals_are_reported() {
+    let d = tempfile::tempdir().unwrap();
+    write(d.path(), "m.mtl", LIT_MTL);
+    // The floor wound clockwise seen from above: its front faces down, away from the lamp.
+    let f = write(
+        d.path(),
+        "flipped.obj",
+        &LIT_OBJ.replace("f 1 2 3 4", "f 4 3 2 1"),
+    );
+    let out = d.path().join("o");
+    let (code, _, err) = run(&[
+        "solve",
+        &f,
+        "--out",
+        out.to_str().unwrap(),
+        "--patch-size",
+        "0.25",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("back faces") && err.contains("flipped"),
+        "{err}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    // The floor catches about a quarter of the lamp's light (a 1 m square 1 m below a small
+    // lamp: F ≈ 0.24); all of it lands on the back face.
+    assert!(json["energy"]["back_fraction"].as_f64().unwrap() > 0.15);
+    assert!(json["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|w| w.as_str().unwrap().contains("flipped")));
+}
