@@ -3,6 +3,7 @@
 //! [`polar`] is the paper's adaptive polar hemisphere sampler (Sec. 2). Directions are in the
 //! shooter's local frame (z = the patch normal); [`Frame`] maps them to world space.
 
+pub mod hemicube;
 pub mod polar;
 
 use glam::Vec3;
