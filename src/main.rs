@@ -7,7 +7,7 @@ use radiosity::mesh::MeshOptions;
 use radiosity::pipeline::{self, CameraSpec, SceneSource, SolveJob};
 use radiosity::render::RenderOptions;
 use radiosity::scene::LoadOptions;
-use radiosity::solve::SolveConfig;
+use radiosity::solve::{MethodKind, SolveConfig};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -112,6 +112,46 @@ struct SolverArgs {
     /// points inside them (biased at low ray counts; for comparison).
     #[arg(long)]
     polar_centres: bool,
+    /// How form factors are sampled.
+    #[arg(long, value_enum, default_value_t = Method::AdaptiveRays)]
+    method: Method,
+    /// Resolution N of the uniform N×N hemi-cube (methods hemicube, hemicube-jittered,
+    /// gathering).
+    #[arg(long, default_value_t = 100, value_name = "N")]
+    hemicube_n: usize,
+    /// Gathering refuses scenes whose form-factor matrix needs more memory than this.
+    #[arg(long, default_value_t = 4096, value_name = "MIB")]
+    gather_cap_mib: u64,
+}
+
+/// `--method`: see `radiosity::solve::MethodKind`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Method {
+    /// Shooting with the paper's adaptive polar hemisphere ray sampler (Sec. 2).
+    AdaptiveRays,
+    /// Shooting with the uniform N×N hemi-cube (Cohen & Greenberg 1985): the baseline.
+    Hemicube,
+    /// The uniform hemi-cube with jittered sample points (the paper's Table 1).
+    HemicubeJittered,
+    /// Shooting with the paper's non-uniform hemi-cube, resolution from the unshot energy.
+    AdaptiveHemicube,
+    /// Adaptive hemi-cube first, adaptive rays once measured cheaper (Sec. 4).
+    AdaptiveHybrid,
+    /// The traditional algorithm: full form-factor matrix, then Gauss–Seidel.
+    Gathering,
+}
+
+impl From<Method> for MethodKind {
+    fn from(m: Method) -> MethodKind {
+        match m {
+            Method::AdaptiveRays => MethodKind::AdaptiveRays,
+            Method::Hemicube => MethodKind::Hemicube,
+            Method::HemicubeJittered => MethodKind::HemicubeJittered,
+            Method::AdaptiveHemicube => MethodKind::AdaptiveHemicube,
+            Method::AdaptiveHybrid => MethodKind::AdaptiveHybrid,
+            Method::Gathering => MethodKind::Gathering,
+        }
+    }
 }
 
 #[derive(Args)]
@@ -230,6 +270,9 @@ impl SolverArgs {
             max_time,
             max_rays: self.max_rays,
             jitter: !self.polar_centres,
+            method: self.method.into(),
+            hemicube_n: self.hemicube_n,
+            gather_cap_mib: self.gather_cap_mib,
         })
     }
 }

@@ -76,6 +76,12 @@ pub fn load_scene(source: &SceneSource, opts: &LoadOptions) -> Result<Scene, Err
 /// Checks settings a user can get wrong, before any work.
 pub fn validate(job: &SolveJob) -> Result<(), Error> {
     let s = &job.solve;
+    if s.method != crate::solve::MethodKind::AdaptiveRays {
+        return Err(Error::Invalid(format!(
+            "--method {} is not available yet",
+            s.method.name()
+        )));
+    }
     if !(s.tolerance > 0.0 && s.tolerance < 1.0) {
         return Err(Error::Invalid(format!(
             "--tolerance must be in (0, 1), got {}",
@@ -225,7 +231,7 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         patch_size: m.patch_size,
         axial_fraction_area: report::axial_fractions(&m).1,
         lights: report::lights(&scene, &m),
-        method: "adaptive-rays",
+        method: job.solve.method.name(),
         intersector: isect.name(),
         seed: job.solve.seed,
         threads: rayon::current_num_threads(),

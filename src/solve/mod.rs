@@ -13,6 +13,41 @@ pub use progressive::solve;
 
 use std::time::Duration;
 
+/// How form factors are sampled (`radiosity solve --method …`; the paper's Sec. 2 and 4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MethodKind {
+    /// Shooting with the adaptive polar hemisphere ray sampler (Sec. 2).
+    #[default]
+    AdaptiveRays,
+    /// Shooting with the uniform N×N hemi-cube of Cohen & Greenberg 1985: the non-adaptive
+    /// baseline.
+    Hemicube,
+    /// The uniform hemi-cube with each cell's sample point jittered (Table 1, third column).
+    HemicubeJittered,
+    /// Shooting with the paper's non-uniform hemi-cube, its resolution from the unshot energy.
+    AdaptiveHemicube,
+    /// The adaptive hemi-cube while shots carry much energy, then adaptive rays once a ray shot
+    /// is measured to be cheaper (Sec. 4: curves C then D).
+    AdaptiveHybrid,
+    /// The traditional algorithm: full form-factor matrix by the uniform hemi-cube, then
+    /// Gauss–Seidel.
+    Gathering,
+}
+
+impl MethodKind {
+    pub fn name(&self) -> &'static str {
+        match self {
+            MethodKind::AdaptiveRays => "adaptive-rays",
+            MethodKind::Hemicube => "hemicube",
+            MethodKind::HemicubeJittered => "hemicube-jittered",
+            MethodKind::AdaptiveHemicube => "adaptive-hemicube",
+            MethodKind::AdaptiveHybrid => "adaptive-hybrid",
+            MethodKind::Gathering => "gathering",
+        }
+    }
+}
+
 /// What the solver does, independent of the scene.
 #[derive(Clone, Debug)]
 pub struct SolveConfig {
@@ -30,6 +65,11 @@ pub struct SolveConfig {
     pub max_rays: Option<u64>,
     /// Place each ray uniformly inside its polar cell (default) rather than at its centre.
     pub jitter: bool,
+    pub method: MethodKind,
+    /// Resolution N of the uniform hemi-cube (the `hemicube` methods and gathering).
+    pub hemicube_n: usize,
+    /// Gathering refuses scenes whose form-factor matrix needs more memory than this (MiB).
+    pub gather_cap_mib: u64,
 }
 
 impl Default for SolveConfig {
@@ -42,6 +82,9 @@ impl Default for SolveConfig {
             max_time: None,
             max_rays: None,
             jitter: true,
+            method: MethodKind::AdaptiveRays,
+            hemicube_n: 100,
+            gather_cap_mib: 4096,
         }
     }
 }
@@ -121,6 +164,26 @@ pub struct SolveStats {
     pub stop_reason: Option<StopReason>,
     pub energy: EnergyBalance,
     pub trace: Vec<TracePoint>,
+    /// Shots taken by hemi-cube, and form-factor samples (cells) they used.
+    pub hemicube_shots: u64,
+    pub hemicube_cells: u64,
+    /// For `adaptive-hybrid`: when and why it switched from the hemi-cube to rays.
+    pub switch: Option<SwitchInfo>,
+}
+
+/// The hemi-cube → rays switch of `adaptive-hybrid` (Sec. 4), with the costs it compared.
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+pub struct SwitchInfo {
+    /// The first shot cast by rays.
+    pub shot: u64,
+    /// Rays that shot needed (X = ΔΦ/C).
+    pub rays: u64,
+    /// Measured wall time one ray costs (s), all threads.
+    pub seconds_per_ray: f64,
+    /// Measured wall time of a hemi-cube shot at that point (s).
+    pub hemicube_shot_seconds: f64,
+    /// The cost of the shot by rays: rays × seconds_per_ray (s).
+    pub ray_shot_seconds: f64,
 }
 
 /// The result: radiosity per patch, and the energy not yet shot.
