@@ -7,6 +7,7 @@
 //! ΔΦ_i / X and the patch it hits first gains ρ_j·ΔΦ_i/X (so ΔB_j += ρ_j·ΔΦ_i·F_ij/A_j with
 //! F_ij estimated by the fraction of rays).
 
+pub mod gathering;
 pub mod progressive;
 
 pub use progressive::solve;
