@@ -4,7 +4,7 @@
 use crate::export::WriteError;
 use crate::intersect::embree::EmbreeError;
 use crate::scene::SceneError;
-use crate::solve::progressive::SolveError;
+use crate::solve::SolveError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum Error {

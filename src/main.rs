@@ -128,7 +128,7 @@ struct SolverArgs {
     /// Stop after this many seconds of solving, whatever the criterion says.
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     max_time: Option<f64>,
-    /// Stop after about this many rays.
+    /// Stop after about this many form-factor samples (rays, plus hemi-cube cells).
     #[arg(long)]
     max_rays: Option<u64>,
     /// Aim rays at the centres of the polar cells, as the paper does, instead of at random
@@ -136,7 +136,7 @@ struct SolverArgs {
     #[arg(long)]
     polar_centres: bool,
     /// How form factors are sampled.
-    #[arg(long, value_enum, default_value_t = Method::AdaptiveRays)]
+    #[arg(long, value_enum, default_value_t = Method::AdaptiveHybrid)]
     method: Method,
     /// Resolution N of the uniform N×N hemi-cube (methods hemicube, hemicube-jittered,
     /// gathering).
@@ -145,6 +145,10 @@ struct SolverArgs {
     /// Gathering refuses scenes whose form-factor matrix needs more memory than this.
     #[arg(long, default_value_t = 4096, value_name = "MIB")]
     gather_cap_mib: u64,
+    /// adaptive-hybrid: switch from hemi-cubes to rays at this shot instead of when the
+    /// measured costs say so (the switch shot a summary.json recorded: an exact replay).
+    #[arg(long, value_name = "SHOT")]
+    switch_at: Option<u64>,
 }
 
 /// `--method`: see `radiosity::solve::MethodKind`.
@@ -296,6 +300,7 @@ impl SolverArgs {
             method: self.method.into(),
             hemicube_n: self.hemicube_n,
             gather_cap_mib: self.gather_cap_mib,
+            switch_at: self.switch_at,
         })
     }
 }

@@ -8,7 +8,7 @@ use crate::mesh::{self, Mesh, MeshOptions};
 use crate::render::{self, Camera, RenderOptions};
 use crate::report::{self, EnergyReport, Summary, Timings};
 use crate::scene::{self, LoadOptions, Scene};
-use crate::solve::{self, SolveConfig, TracePoint};
+use crate::solve::{self, MethodKind, SolveConfig, TracePoint};
 use crate::Error;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
@@ -76,10 +76,16 @@ pub fn load_scene(source: &SceneSource, opts: &LoadOptions) -> Result<Scene, Err
 /// Checks settings a user can get wrong, before any work.
 pub fn validate(job: &SolveJob) -> Result<(), Error> {
     let s = &job.solve;
-    if s.method != crate::solve::MethodKind::AdaptiveRays {
+    if s.switch_at.is_some() && s.method != MethodKind::AdaptiveHybrid {
         return Err(Error::Invalid(format!(
-            "--method {} is not available yet",
+            "--switch-at applies to --method adaptive-hybrid only, not {}",
             s.method.name()
+        )));
+    }
+    if !(2..=4096).contains(&s.hemicube_n) {
+        return Err(Error::Invalid(format!(
+            "--hemicube-n must be between 2 and 4096, got {}",
+            s.hemicube_n
         )));
     }
     if !(s.tolerance > 0.0 && s.tolerance < 1.0) {
@@ -168,15 +174,20 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         m.patches.len()
     ));
 
+    // Only the methods that cast rays need an intersector (a scene builds what it needs).
     let t = Instant::now();
-    let isect = EmbreeScene::build(&m, |_| true)?;
+    let isect = if job.solve.method.casts_rays() {
+        Some(EmbreeScene::build(&m, |_| true)?)
+    } else {
+        None
+    };
     timings.build = t.elapsed().as_secs_f64();
 
     let t = Instant::now();
-    let sol = solve::solve(
+    let sol = solve::run(
         &m,
         &scene.materials,
-        &isect,
+        isect.as_ref(),
         &job.solve,
         |_p: &TracePoint| {},
     )
@@ -232,7 +243,7 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         axial_fraction_area: report::axial_fractions(&m).1,
         lights: report::lights(&scene, &m),
         method: job.solve.method.name(),
-        intersector: isect.name(),
+        intersector: isect.as_ref().map_or("none (no rays cast)", |i| i.name()),
         seed: job.solve.seed,
         threads: rayon::current_num_threads(),
         tolerance: job.solve.tolerance,
@@ -242,6 +253,14 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         shots: sol.stats.shots,
         rays: sol.stats.rays,
         waves: sol.stats.waves,
+        hemicube_shots: sol.stats.hemicube_shots,
+        hemicube_cells: sol.stats.hemicube_cells,
+        hemicube_n: matches!(
+            job.solve.method,
+            MethodKind::Hemicube | MethodKind::HemicubeJittered | MethodKind::Gathering
+        )
+        .then_some(job.solve.hemicube_n),
+        switch: sol.stats.switch,
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
         seconds: timings,
         energy,
@@ -350,6 +369,11 @@ pub fn bench_rays(
     cfg: &SolveConfig,
     raw_rays: u64,
 ) -> Result<RayBench, Error> {
+    // The solver's rays are what is measured: the ray shooter, whatever --method says.
+    let cfg = &SolveConfig {
+        method: solve::MethodKind::AdaptiveRays,
+        ..cfg.clone()
+    };
     let scene = load_scene(source, load)?;
     let m = mesh::build(&scene, mesh_opts);
     let isect = EmbreeScene::build(&m, |_| true)?;

@@ -2,7 +2,7 @@
 
 use crate::mesh::{Mesh, PatchClass};
 use crate::scene::Scene;
-use crate::solve::{scalar, EnergyBalance, SolveStats, StopReason, TracePoint};
+use crate::solve::{scalar, EnergyBalance, SolveStats, StopReason, SwitchInfo, TracePoint};
 use serde::Serialize;
 
 /// An emitting material and the power it puts out.
@@ -221,6 +221,15 @@ pub struct Summary {
     pub shots: u64,
     pub rays: u64,
     pub waves: u64,
+    /// Shots taken by hemi-cube (the `hemicube` methods, and `adaptive-hybrid` before it
+    /// switched), and their cells (form-factor samples).
+    pub hemicube_shots: u64,
+    pub hemicube_cells: u64,
+    /// Resolution N of the uniform hemi-cube (`hemicube`, `hemicube-jittered`, `gathering`).
+    pub hemicube_n: Option<usize>,
+    /// `adaptive-hybrid`: the shot at which it switched from hemi-cubes to rays, and the
+    /// measured costs that decided it (Sec. 4).
+    pub switch: Option<SwitchInfo>,
     /// Rays cast per second of solve time.
     pub rays_per_second: f64,
     pub seconds: Timings,
@@ -235,12 +244,29 @@ pub struct Summary {
 
 impl Summary {
     pub fn stats_line(stats: &SolveStats) -> String {
-        format!(
-            "{} shots, {} rays in {:.2} s ({:.2} Mrays/s)",
-            stats.shots,
-            stats.rays,
-            stats.seconds,
-            stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
-        )
+        let mut line = format!("{} shots", stats.shots);
+        if stats.hemicube_shots > 0 {
+            line += &format!(
+                " ({} by hemi-cube, {} cells)",
+                stats.hemicube_shots, stats.hemicube_cells
+            );
+        }
+        if let Some(s) = &stats.switch {
+            line += &format!(
+                ", switched to rays at shot {} (hemi-cube {:.2} ms vs {} rays {:.2} ms)",
+                s.shot,
+                1e3 * s.hemicube_shot_seconds,
+                s.rays,
+                1e3 * s.ray_shot_seconds
+            );
+        }
+        if stats.rays > 0 {
+            line += &format!(
+                ", {} rays ({:.2} Mrays/s)",
+                stats.rays,
+                stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
+            );
+        }
+        line + &format!(" in {:.2} s", stats.seconds)
     }
 }

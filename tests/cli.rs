@@ -282,3 +282,68 @@ fn flipped_normals_are_reported() {
         .iter()
         .any(|w| w.as_str().unwrap().contains("flipped")));
 }
+
+/// Every `--method` solves the blocks scene from the command line and says what it did; the
+/// summary records the hybrid's switch.
+#[test]
+fn every_method_runs_from_the_command_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/blocks.obj");
+    for method in [
+        "adaptive-rays",
+        "hemicube",
+        "hemicube-jittered",
+        "adaptive-hemicube",
+        "adaptive-hybrid",
+        "gathering",
+    ] {
+        let out = dir.path().join(method);
+        let (code, stdout, err) = run(&[
+            "solve",
+            scene.to_str().unwrap(),
+            "--method",
+            method,
+            "--hemicube-n",
+            "40",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{method}: {err}");
+        assert!(!stdout.contains("NaN") && !err.contains("NaN"));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["method"], method);
+        if method == "adaptive-hybrid" {
+            assert!(
+                summary["switch"]["shot"].as_u64().unwrap() >= 1,
+                "{summary}"
+            );
+        }
+        if method.contains("hemicube") || method == "gathering" {
+            assert_eq!(summary["rays"], 0, "{method}");
+            assert!(summary["hemicube_cells"].as_u64().unwrap() > 0);
+        }
+    }
+}
+
+#[test]
+fn gathering_refuses_a_matrix_over_the_cap() {
+    assert_user_error(
+        &["solve", "--method", "gathering", "--gather-cap-mib", "1"],
+        &["gathering", "patches", "MiB", "--gather-cap-mib"],
+    );
+}
+
+#[test]
+fn switch_at_needs_the_hybrid() {
+    assert_user_error(
+        &["solve", "--method", "hemicube", "--switch-at", "3"],
+        &["--switch-at", "adaptive-hybrid"],
+    );
+    assert_user_error(&["solve", "--hemicube-n", "1"], &["--hemicube-n"]);
+}

@@ -9,7 +9,7 @@ use radiosity::intersect::embree::EmbreeScene;
 use radiosity::intersect::Intersector;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::Scene;
-use radiosity::solve::{self, scalar, Solution, SolveConfig, StopReason};
+use radiosity::solve::{self, scalar, MethodKind, Solution, SolveConfig, StopReason};
 
 fn mesh_of(scene: &Scene, patch_size: f32) -> Mesh {
     mesh::build(
@@ -33,7 +33,7 @@ fn closed_box_reaches_e_over_one_minus_rho() {
     let m = mesh_of(&scene, 0.25);
     assert_eq!(m.patches.len(), 96);
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
-    let sol = run(&scene, &m, &isect, &SolveConfig::default());
+    let sol = run(&scene, &m, &isect, &ray_config());
     let exact = 1.0 / (1.0 - rho);
     let errs: Vec<f64> = sol.b.iter().map(|b| (b[0] - exact).abs() / exact).collect();
     let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len() as f64).sqrt();
@@ -101,7 +101,7 @@ fn form_factor<I: Intersector>(scene: &Scene, m: &Mesh, isect: &I, rays: f64) ->
     let emitted = std::f64::consts::PI; // E = π·Ke = π over 1 m²
     let cfg = SolveConfig {
         energy_per_ray: Some(emitted / rays),
-        ..SolveConfig::default()
+        ..ray_config()
     };
     let sol = run(scene, m, isect, &cfg);
     assert_eq!(sol.stats.shots, 1);
@@ -147,7 +147,7 @@ fn no_ray_escapes_a_closed_box() {
         // About 10⁶ rays in all: the emitted flux / C, over (1 − ρ) for the bounces, and the
         // stop criterion cuts the tail.
         energy_per_ray: Some(emitted / (1.0e6 * 0.45)),
-        ..SolveConfig::default()
+        ..ray_config()
     };
     let sol = run(&scene, &m, &isect, &cfg);
     assert!(sol.stats.rays >= 1_000_000, "rays {}", sol.stats.rays);
@@ -168,7 +168,7 @@ fn result_does_not_depend_on_thread_count() {
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let cfg = SolveConfig {
         seed: 42,
-        ..SolveConfig::default()
+        ..ray_config()
     };
     let solve_on = |threads: usize| {
         rayon::ThreadPoolBuilder::new()
@@ -192,4 +192,12 @@ fn result_does_not_depend_on_thread_count() {
         },
     );
     assert_ne!(one.b, other.b);
+}
+
+/// The ray shooter's settings: these tests count rays.
+fn ray_config() -> SolveConfig {
+    SolveConfig {
+        method: MethodKind::AdaptiveRays,
+        ..SolveConfig::default()
+    }
 }

@@ -124,10 +124,12 @@ pub fn gauss_seidel(
     (b, sweeps)
 }
 
-/// Progressive shooting over an explicit matrix (Cohen et al. 1988): the test twin of
-/// [`gauss_seidel`]. Shoots the patch with most unshot flux until max unshot radiosity is below
-/// `stop_fraction` of the mean. Uses reciprocity A_i·F_ij = A_j·F_ji to turn the gathering
-/// matrix's rows into what i sends to j: ΔΦ_i·F_ij.
+/// Progressive shooting (Southwell iteration, as in Cohen et al. 1988) over the same linear
+/// system B = E + ρ·F·B that [`gauss_seidel`] solves: the test twin of gathering. Shoots the
+/// patch with the most unshot flux ΔB_i·A_i until max unshot radiosity is below `stop_fraction`
+/// of the mean; patch j gains ρ_j·F_ji·ΔB_i (column i of F). Hemi-cube form factors are
+/// reciprocal (A_i·F_ij = A_j·F_ji) only approximately, so shooting along row i instead, as a
+/// hemi-cube shot does, would solve a slightly different system.
 pub fn shoot_matrix(
     ff: &FormFactors,
     e: &[[f64; 3]],
@@ -137,30 +139,27 @@ pub fn shoot_matrix(
 ) -> Vec<[f64; 3]> {
     let n = ff.n;
     let mut b: Vec<[f64; 3]> = e.to_vec();
-    let mut unshot: Vec<[f64; 3]> = (0..n).map(|i| e[i].map(|x| x * area[i])).collect();
+    let mut unshot: Vec<[f64; 3]> = e.to_vec();
     let total_area: f64 = area.iter().sum();
     loop {
-        let (i, _) = unshot
-            .iter()
-            .enumerate()
-            .map(|(i, u)| (i, scalar(u)))
+        let (i, _) = (0..n)
+            .map(|k| (k, scalar(&unshot[k]) * area[k]))
             .fold((0, -1.0), |best, x| if x.1 > best.1 { x } else { best });
-        let max_b = (0..n)
-            .map(|k| scalar(&unshot[k]) / area[k])
-            .fold(0.0, f64::max);
+        let max_b = (0..n).map(|k| scalar(&unshot[k])).fold(0.0, f64::max);
         let mean: f64 = b.iter().zip(area).map(|(b, a)| scalar(b) * a).sum::<f64>() / total_area;
         if max_b <= stop_fraction * mean {
             return b;
         }
-        let phi = std::mem::replace(&mut unshot[i], [0.0; 3]);
-        for (j, &fij) in ff.row(i).iter().enumerate() {
-            if fij == 0.0 {
+        let db = std::mem::replace(&mut unshot[i], [0.0; 3]);
+        for j in 0..n {
+            let fji = ff.f[j * n + i];
+            if fji == 0.0 {
                 continue;
             }
             for c in 0..3 {
-                let kept = rho[j][c] * phi[c] * fij as f64;
-                unshot[j][c] += kept;
-                b[j][c] += kept / area[j];
+                let gain = rho[j][c] * fji as f64 * db[c];
+                unshot[j][c] += gain;
+                b[j][c] += gain;
             }
         }
     }
@@ -220,7 +219,9 @@ pub fn gather(
     let seconds = start.elapsed().as_secs_f64();
     let stats = SolveStats {
         shots: n as u64,
-        rays: (n as u64) * Hemicube::uniform(n_cube).cell_count() as u64,
+        rays: 0,
+        hemicube_shots: n as u64,
+        hemicube_cells: (n as u64) * Hemicube::uniform(n_cube).cell_count() as u64,
         waves: sweeps as u64,
         seconds,
         energy_per_ray: 0.0,
@@ -231,6 +232,7 @@ pub fn gather(
                 time_s: matrix_s,
                 shots: n as u64,
                 rays: 0,
+                cells: 0,
                 max_unshot_b: 0.0,
                 mean_b: 0.0,
                 unshot_flux: 0.0,
@@ -239,6 +241,7 @@ pub fn gather(
                 time_s: seconds,
                 shots: n as u64,
                 rays: 0,
+                cells: 0,
                 max_unshot_b: 0.0,
                 mean_b,
                 unshot_flux: 0.0,

@@ -7,10 +7,14 @@
 //! ΔΦ_i / X and the patch it hits first gains ρ_j·ΔΦ_i/X (so ΔB_j += ρ_j·ΔΦ_i·F_ij/A_j with
 //! F_ij estimated by the fraction of rays).
 
+pub mod cube_shots;
 pub mod gathering;
 pub mod progressive;
+mod state;
 
-pub use progressive::solve;
+use crate::intersect::Intersector;
+use crate::mesh::Mesh;
+use crate::scene::Material;
 
 use std::time::Duration;
 
@@ -19,7 +23,6 @@ use std::time::Duration;
 #[serde(rename_all = "kebab-case")]
 pub enum MethodKind {
     /// Shooting with the adaptive polar hemisphere ray sampler (Sec. 2).
-    #[default]
     AdaptiveRays,
     /// Shooting with the uniform N×N hemi-cube of Cohen & Greenberg 1985: the non-adaptive
     /// baseline.
@@ -29,7 +32,8 @@ pub enum MethodKind {
     /// Shooting with the paper's non-uniform hemi-cube, its resolution from the unshot energy.
     AdaptiveHemicube,
     /// The adaptive hemi-cube while shots carry much energy, then adaptive rays once a ray shot
-    /// is measured to be cheaper (Sec. 4: curves C then D).
+    /// is measured to be cheaper (Sec. 4: curves C then D). The default.
+    #[default]
     AdaptiveHybrid,
     /// The traditional algorithm: full form-factor matrix by the uniform hemi-cube, then
     /// Gauss–Seidel.
@@ -37,6 +41,11 @@ pub enum MethodKind {
 }
 
 impl MethodKind {
+    /// Whether the method casts rays (and so needs an intersector).
+    pub fn casts_rays(&self) -> bool {
+        matches!(self, MethodKind::AdaptiveRays | MethodKind::AdaptiveHybrid)
+    }
+
     pub fn name(&self) -> &'static str {
         match self {
             MethodKind::AdaptiveRays => "adaptive-rays",
@@ -71,6 +80,10 @@ pub struct SolveConfig {
     pub hemicube_n: usize,
     /// Gathering refuses scenes whose form-factor matrix needs more memory than this (MiB).
     pub gather_cap_mib: u64,
+    /// `adaptive-hybrid`: switch to rays at this shot instead of when measured costs say so.
+    /// The measured switch depends on timings, so it can differ between runs; giving the shot
+    /// a summary recorded makes the run reproducible exactly.
+    pub switch_at: Option<u64>,
 }
 
 impl Default for SolveConfig {
@@ -83,9 +96,10 @@ impl Default for SolveConfig {
             max_time: None,
             max_rays: None,
             jitter: true,
-            method: MethodKind::AdaptiveRays,
+            method: MethodKind::AdaptiveHybrid,
             hemicube_n: 100,
             gather_cap_mib: 4096,
+            switch_at: None,
         }
     }
 }
@@ -108,6 +122,8 @@ pub struct TracePoint {
     pub time_s: f64,
     pub shots: u64,
     pub rays: u64,
+    /// Hemi-cube cells of the shots so far (form-factor samples, like rays).
+    pub cells: u64,
     /// Max unshot radiosity over patches (scalar: mean of RGB), W/m².
     pub max_unshot_b: f64,
     /// Area-weighted mean radiosity (scalar), W/m².
@@ -185,6 +201,10 @@ pub struct SwitchInfo {
     pub hemicube_shot_seconds: f64,
     /// The cost of the shot by rays: rays × seconds_per_ray (s).
     pub ray_shot_seconds: f64,
+    /// Cells of the hemi-cube that shot would have used.
+    pub hemicube_cells: u64,
+    /// Whether `--switch-at` set the shot rather than the measured costs.
+    pub forced: bool,
 }
 
 /// The result: radiosity per patch, and the energy not yet shot.
@@ -201,4 +221,56 @@ pub struct Solution {
 #[inline]
 pub fn scalar(v: &[f64; 3]) -> f64 {
     (v[0] + v[1] + v[2]) / 3.0
+}
+
+/// Errors a user can cause.
+#[derive(Debug, thiserror::Error)]
+pub enum SolveError {
+    #[error("the scene has no light: no material emits (give one a Ke in the MTL file, or use --emit MATERIAL=R,G,B)")]
+    NoEmitter,
+    #[error("the scene has {0} patches; at most {max} are supported", max = progressive::BACK - 1)]
+    TooManyPatches(usize),
+    #[error(transparent)]
+    GatherTooLarge(#[from] gathering::TooLarge),
+    #[error("--method {0} casts rays but no intersector was built")]
+    NoIntersector(&'static str),
+}
+
+/// Solves by the method `cfg.method` names, casting rays through `isect`.
+pub fn solve<I: Intersector>(
+    mesh: &Mesh,
+    materials: &[Material],
+    isect: &I,
+    cfg: &SolveConfig,
+    on_trace: impl FnMut(&TracePoint),
+) -> Result<Solution, SolveError> {
+    run(mesh, materials, Some(isect), cfg, on_trace)
+}
+
+/// Solves by the method `cfg.method` names. `isect` is needed only by methods that cast rays
+/// ([`MethodKind::casts_rays`]): the hemi-cube methods and gathering build none.
+pub fn run<I: Intersector>(
+    mesh: &Mesh,
+    materials: &[Material],
+    isect: Option<&I>,
+    cfg: &SolveConfig,
+    mut on_trace: impl FnMut(&TracePoint),
+) -> Result<Solution, SolveError> {
+    match cfg.method {
+        MethodKind::Gathering => {
+            gathering::check_size(mesh.patches.len(), cfg.gather_cap_mib)?;
+            if !mesh
+                .patches
+                .iter()
+                .any(|p| materials[p.material as usize].is_emitter())
+            {
+                return Err(SolveError::NoEmitter);
+            }
+            let sol =
+                gathering::gather(mesh, materials, cfg.hemicube_n, cfg.seed, cfg.stop_fraction);
+            sol.stats.trace.iter().for_each(&mut on_trace);
+            Ok(sol)
+        }
+        _ => progressive::shoot(mesh, materials, isect, cfg, on_trace),
+    }
 }

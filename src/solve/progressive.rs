@@ -15,17 +15,19 @@
 //! composition does not depend on the thread count, so results are identical on any number of
 //! threads.
 
-use super::{scalar, EnergyBalance, Solution, SolveConfig, SolveStats, StopReason, TracePoint};
+use super::cube_shots::{self, CubeCost, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WAVE};
+use super::state::{rng_for, State};
+use super::{
+    scalar, MethodKind, Solution, SolveConfig, SolveError, SolveStats, StopReason, SwitchInfo,
+    TracePoint,
+};
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::Mesh;
 use crate::sample::{polar::PolarGrid, Frame};
 use crate::scene::Material;
 use glam::Vec3;
-use rand::{Rng, SeedableRng};
-use rand_pcg::Pcg64Mcg;
+use rand::Rng;
 use rayon::prelude::*;
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 use std::time::Instant;
 
 /// Rays per wave of shots (see the module docs). Fixed, so results do not depend on threads.
@@ -33,17 +35,8 @@ pub const WAVE_RAYS: usize = 32_768;
 /// Rays per parallel task.
 const CHUNK: usize = 1024;
 /// Hit codes: a patch id, a patch id with this bit for a back-face hit, or [`ESCAPED`].
-const BACK: u32 = 1 << 31;
+pub(super) const BACK: u32 = 1 << 31;
 const ESCAPED: u32 = u32::MAX;
-
-/// Errors a user can cause.
-#[derive(Debug, thiserror::Error)]
-pub enum SolveError {
-    #[error("the scene has no light: no material emits (give one a Ke in the MTL file, or use --emit MATERIAL=R,G,B)")]
-    NoEmitter,
-    #[error("the scene has {0} patches; at most {max} are supported", max = BACK - 1)]
-    TooManyPatches(usize),
-}
 
 /// The energy per ray C (scalar W) for a requested relative error τ of a typical patch.
 ///
@@ -63,54 +56,6 @@ pub fn energy_per_ray(mesh: &Mesh, rho: &[[f64; 3]], emitted: f64, tolerance: f6
     emitted * tolerance * tolerance / (n * (1.0 - rho_mean).max(1e-3))
 }
 
-/// A heap entry: a key and the patch it was computed for. Stale when the patch's current key
-/// differs (the heap is updated lazily: new entries are pushed, old ones skipped when popped).
-#[derive(Clone, Copy, PartialEq)]
-struct Entry(f64, u32);
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.0.total_cmp(&o.0).then(o.1.cmp(&self.1))
-    }
-}
-
-/// Max-heap of patches by a key, with lazy deletion.
-struct LazyHeap {
-    heap: BinaryHeap<Entry>,
-}
-
-impl LazyHeap {
-    fn push(&mut self, key: f64, i: usize) {
-        if key > 0.0 {
-            self.heap.push(Entry(key, i as u32));
-        }
-    }
-    /// The top entry still current under `key_of`, dropping stale ones.
-    fn peek(&mut self, key_of: impl Fn(usize) -> f64) -> Option<Entry> {
-        while let Some(&top) = self.heap.peek() {
-            if key_of(top.1 as usize) == top.0 {
-                return Some(top);
-            }
-            self.heap.pop();
-        }
-        None
-    }
-    /// Rebuilds from scratch when stale entries pile up (keeps memory O(patches)).
-    fn compact(&mut self, n: usize, key_of: impl Fn(usize) -> f64) {
-        if self.heap.len() > 4 * n + 1024 {
-            self.heap = (0..n)
-                .map(|i| Entry(key_of(i), i as u32))
-                .filter(|e| e.0 > 0.0)
-                .collect();
-        }
-    }
-}
-
 /// One shooter of a wave.
 struct Shot {
     patch: usize,
@@ -119,26 +64,6 @@ struct Shot {
     /// The flux it shoots, RGB.
     phi: [f64; 3],
     grid: PolarGrid,
-}
-
-/// a += b, per channel.
-#[inline]
-fn add3(a: &mut [f64; 3], b: &[f64; 3]) {
-    for (x, y) in a.iter_mut().zip(b) {
-        *x += y;
-    }
-}
-
-/// splitmix64: decorrelates (seed, shot, chunk) into independent RNG seeds.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-fn rng_for(seed: u64, shot: u64, chunk: u64) -> Pcg64Mcg {
-    Pcg64Mcg::seed_from_u64(mix(mix(mix(seed) ^ shot) ^ chunk))
 }
 
 /// Draws points uniformly over the area of one convex patch: a fan triangle chosen by area,
@@ -230,121 +155,51 @@ impl<I: Intersector> Ctx<'_, I> {
         }
         ESCAPED
     }
-}
 
-/// Per-patch solver state, packed into one cache line so applying a hit costs one miss.
-/// Energies are f64; ρ and 1/A are stored as f32 (exact enough for a reflectance, and the
-/// energy books stay exact because what is absorbed is computed as Φ − ρΦ in f64).
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-struct PatchState {
-    /// Unshot flux ΔΦ_j (W).
-    unshot: [f64; 3],
-    /// Flux received and kept (ρ_j × what arrived), W: B_j = E_j + gathered/A_j.
-    gathered: [f64; 3],
-    rho: [f32; 3],
-    inv_area: f32,
-}
-
-/// The solver's mutable state: patches, heaps and energy accounts.
-struct State {
-    patches: Vec<PatchState>,
-    by_flux: LazyHeap,
-    by_b: LazyHeap,
-    energy: EnergyBalance,
-    /// Σ B_j·A_j, for the mean radiosity.
-    b_flux: [f64; 3],
-    touched: Vec<bool>,
-    touched_list: Vec<u32>,
-    rays: u64,
-    stop_fraction: f64,
-    total_area: f64,
-}
-
-impl State {
-    #[inline]
-    fn key_flux(&self, i: usize) -> f64 {
-        scalar(&self.patches[i].unshot)
-    }
-    #[inline]
-    fn key_b(&self, i: usize) -> f64 {
-        scalar(&self.patches[i].unshot) * self.patches[i].inv_area as f64
-    }
-
-    /// Max unshot radiosity (scalar) over all patches, from the heap.
-    fn max_unshot_b(&mut self) -> f64 {
-        let patches = &self.patches;
-        self.by_b
-            .peek(|i| scalar(&patches[i].unshot) * patches[i].inv_area as f64)
-            .map_or(0.0, |e| e.0)
-    }
-
-    /// Is any unshot energy left?
-    fn has_unshot(&mut self) -> bool {
-        let patches = &self.patches;
-        self.by_flux.peek(|i| scalar(&patches[i].unshot)).is_some()
-    }
-
-    /// Takes the patch with the most unshot flux off the heap, if any.
-    fn pop_shooter(&mut self) -> Option<(usize, f64)> {
-        let patches = &self.patches;
-        let top = self.by_flux.peek(|i| scalar(&patches[i].unshot))?;
-        self.by_flux.heap.pop();
-        Some((top.1 as usize, top.0))
-    }
-
-    /// Applies a wave's hits in task order: receivers gain ρ_j·ΔΦ_i/X, the rest is absorbed.
-    fn apply(&mut self, wave: &[Shot], tasks: &[Task], hits: &[Vec<u32>]) {
-        for (task, codes) in tasks.iter().zip(hits) {
-            let shot = &wave[task.shot];
-            let phi_ray = shot.phi.map(|p| p / shot.grid.len() as f64);
-            for &code in codes {
-                if code == ESCAPED {
-                    add3(&mut self.energy.escaped, &phi_ray);
-                } else if code & BACK != 0 {
-                    add3(&mut self.energy.absorbed_back, &phi_ray);
-                } else {
-                    let j = code as usize;
-                    let p = &mut self.patches[j];
-                    for (c, &phi) in phi_ray.iter().enumerate() {
-                        let kept = p.rho[c] as f64 * phi;
-                        p.unshot[c] += kept;
-                        p.gathered[c] += kept;
-                        self.b_flux[c] += kept;
-                        self.energy.absorbed[c] += phi - kept;
-                    }
-                    if !self.touched[j] {
-                        self.touched[j] = true;
-                        self.touched_list.push(code);
-                    }
-                }
-            }
-            self.rays += codes.len() as u64;
+    /// Sec. 4's cost of ray sampling, measured: thread time per ray (s) of a few thousand rays
+    /// from `patch`, cast like a shot's but not applied. Twice, keeping the second (the first
+    /// warms the caches up).
+    fn probe(&self, patch: usize) -> f64 {
+        let shot = Shot {
+            patch,
+            index: u64::MAX - 1,
+            phi: [0.0; 3],
+            grid: PolarGrid::for_samples((4 * CHUNK) as f64),
+        };
+        let tasks = tasks_of(std::slice::from_ref(&shot));
+        let mut per_ray = 0.0;
+        for _ in 0..2 {
+            let (secs, rays) = tasks
+                .par_iter()
+                .map(|t| {
+                    let t0 = Instant::now();
+                    let n = self.cast(&shot, t.chunk, t.first, t.count).len();
+                    (t0.elapsed().as_secs_f64(), n)
+                })
+                .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            per_ray = secs / rays.max(1) as f64;
         }
-        // New heap entries for every patch whose unshot energy grew. The max-ΔB heap only
-        // needs patches that could block convergence: the threshold f·mean(B) never falls
-        // (B only grows), so a patch below it now matters again only once it grows, and then
-        // it is pushed again.
-        let threshold = self.stop_fraction * scalar(&self.b_flux) / self.total_area;
-        let list = std::mem::take(&mut self.touched_list);
-        for &j in &list {
-            let j = j as usize;
-            self.touched[j] = false;
-            let (kf, kb) = (self.key_flux(j), self.key_b(j));
-            self.by_flux.push(kf, j);
-            if kb >= threshold {
-                self.by_b.push(kb, j);
+        per_ray
+    }
+}
+
+/// Applies a wave's hits in task order: receivers gain ρ_j·ΔΦ_i/X, the rest is absorbed.
+fn apply_rays(st: &mut State, wave: &[Shot], tasks: &[Task], hits: &[Vec<u32>]) {
+    for (task, codes) in tasks.iter().zip(hits) {
+        let shot = &wave[task.shot];
+        let phi_ray = shot.phi.map(|p| p / shot.grid.len() as f64);
+        for &code in codes {
+            if code == ESCAPED {
+                st.escape(&phi_ray);
+            } else if code & BACK != 0 {
+                st.deposit_back(&phi_ray);
+            } else {
+                st.deposit(code as usize, &phi_ray);
             }
         }
-        self.touched_list = list;
-        self.touched_list.clear();
-        let n = self.patches.len();
-        let patches = &self.patches;
-        self.by_flux.compact(n, |i| scalar(&patches[i].unshot));
-        self.by_b.compact(n, |i| {
-            scalar(&patches[i].unshot) * patches[i].inv_area as f64
-        });
+        st.rays += codes.len() as u64;
     }
+    st.finish_batch();
 }
 
 /// A chunk of one shot's rays: the unit of parallel work.
@@ -378,63 +233,32 @@ fn tasks_of(wave: &[Shot]) -> Vec<Task> {
         .collect()
 }
 
-/// Solves by progressive refinement. `on_wave` is called with each new trace point (for
-/// progress display).
+/// Shoots until Sec. 3's criterion or a budget stops it, by the method `cfg.method` names
+/// (any but gathering). `isect` is needed by the methods that cast rays (`adaptive-rays`,
+/// `adaptive-hybrid`); the hemi-cube methods never cast a ray. `on_trace` is called with each
+/// new trace point (for progress display).
 ///
-/// Waves are pipelined: while one thread applies wave k's hits, the others cast wave k + 1,
-/// which was taken off the heap before wave k's deposits reached it. Its shooters are then
-/// at most one wave out of date; the energy books stay exact and the order stays fixed, so the
-/// result is still the same on any thread count.
-pub fn solve<I: Intersector>(
+/// Ray waves are pipelined: while one thread applies wave k's hits, the others cast wave
+/// k + 1, which was taken off the heap before wave k's deposits reached it. Its shooters are
+/// then at most one wave out of date; the energy books stay exact and the order stays fixed,
+/// so the result is still the same on any thread count.
+pub fn shoot<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
-    isect: &I,
+    isect: Option<&I>,
     cfg: &SolveConfig,
-    mut on_wave: impl FnMut(&TracePoint),
+    mut on_trace: impl FnMut(&TracePoint),
 ) -> Result<Solution, SolveError> {
     let start = Instant::now();
     let n = mesh.patches.len();
     if n >= BACK as usize {
         return Err(SolveError::TooManyPatches(n));
     }
-    let patches: Vec<PatchState> = mesh
-        .patches
-        .iter()
-        .map(|p| {
-            let m = &materials[p.material as usize];
-            let e = m.emission();
-            PatchState {
-                unshot: e.map(|x| x * p.area),
-                gathered: [0.0; 3],
-                rho: m.rho.map(|r| r as f32),
-                inv_area: (1.0 / p.area) as f32,
-            }
-        })
-        .collect();
-    let mut st = State {
-        patches,
-        by_flux: LazyHeap {
-            heap: BinaryHeap::new(),
-        },
-        by_b: LazyHeap {
-            heap: BinaryHeap::new(),
-        },
-        energy: EnergyBalance::default(),
-        b_flux: [0.0; 3],
-        touched: vec![false; n],
-        touched_list: Vec::new(),
-        rays: 0,
-        stop_fraction: cfg.stop_fraction,
-        total_area: mesh.total_area(),
-    };
-    for i in 0..n {
-        let p = st.patches[i];
-        add3(&mut st.energy.emitted, &p.unshot);
-        add3(&mut st.b_flux, &p.unshot);
-        let (kf, kb) = (st.key_flux(i), st.key_b(i));
-        st.by_flux.push(kf, i);
-        st.by_b.push(kb, i);
+    let method = cfg.method;
+    if method.casts_rays() && isect.is_none() {
+        return Err(SolveError::NoIntersector(method.name()));
     }
+    let mut st = State::new(mesh, materials, cfg.stop_fraction);
     if scalar(&st.energy.emitted) <= 0.0 {
         return Err(SolveError::NoEmitter);
     }
@@ -448,20 +272,34 @@ pub fn solve<I: Intersector>(
         .filter(|c| *c > 0.0)
         .unwrap_or_else(|| energy_per_ray(mesh, &rho, scalar(&st.energy.emitted), cfg.tolerance));
     drop(rho);
-    let total_area = mesh.total_area();
 
     let (lo, hi) = mesh.vertices.iter().fold(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
         |(l, h), v| (l.min(*v), h.max(*v)),
     );
     let reach = lo.abs().max(hi.abs()).max_element();
-    let ctx = Ctx {
+    let ctx = isect.map(|isect| Ctx {
         mesh,
         isect,
         seed: cfg.seed,
         jitter: cfg.jitter,
         eps_floor: reach * 5e-7,
+    });
+    let mut cubes = match method {
+        MethodKind::Hemicube | MethodKind::HemicubeJittered => Some(CubeShooter::new(
+            CubeKind::Uniform {
+                n: cfg.hemicube_n,
+                jitter: method == MethodKind::HemicubeJittered,
+            },
+            c_ray,
+        )),
+        MethodKind::AdaptiveHemicube | MethodKind::AdaptiveHybrid => {
+            Some(CubeShooter::new(CubeKind::Adaptive, c_ray))
+        }
+        MethodKind::AdaptiveRays | MethodKind::Gathering => None,
     };
+    let mut cube_cost = CubeCost::default();
+    let mut ray_cost: Option<f64> = None;
 
     let mut stats = SolveStats {
         energy_per_ray: c_ray,
@@ -472,11 +310,13 @@ pub fn solve<I: Intersector>(
     let stop_reason = loop {
         // Sec. 3's criterion, then the budgets.
         let max_b = st.max_unshot_b();
-        let mean_b = scalar(&st.b_flux) / total_area;
+        let mean_b = st.mean_b();
         let elapsed = start.elapsed().as_secs_f64();
         let in_flight = pending
             .as_ref()
-            .map_or(0, |p| p.hits.iter().map(Vec::len).sum::<usize>());
+            .map_or(0, |p| p.hits.iter().map(Vec::len).sum::<usize>())
+            as u64;
+        let samples = st.rays + st.cells + in_flight;
         let reason = if max_b < cfg.stop_fraction * mean_b {
             // The max-ΔB heap holds only patches above the threshold; whether any energy at
             // all is left, the flux heap says.
@@ -487,10 +327,7 @@ pub fn solve<I: Intersector>(
             }
         } else if cfg.max_time.is_some_and(|t| elapsed >= t.as_secs_f64()) {
             Some(StopReason::MaxTime)
-        } else if cfg
-            .max_rays
-            .is_some_and(|r| st.rays + in_flight as u64 >= r)
-        {
+        } else if cfg.max_rays.is_some_and(|r| samples >= r) {
             Some(StopReason::MaxRays)
         } else {
             None
@@ -498,42 +335,100 @@ pub fn solve<I: Intersector>(
         if let Some(r) = reason {
             // Deposits still in flight may change the verdict: apply them and look again.
             if let Some(p) = pending.take() {
-                st.apply(&p.wave, &p.tasks, &p.hits);
+                apply_rays(&mut st, &p.wave, &p.tasks, &p.hits);
                 continue;
             }
-            record(&mut stats, &st, elapsed, max_b, mean_b, &mut on_wave);
+            st.record(&mut stats, elapsed, max_b, &mut on_trace);
             break r;
         }
         if elapsed >= next_trace {
-            record(&mut stats, &st, elapsed, max_b, mean_b, &mut on_wave);
+            st.record(&mut stats, elapsed, max_b, &mut on_trace);
             next_trace = (elapsed * 1.25).max(elapsed + 0.002);
         }
+
+        if let Some(shooter) = cubes.as_mut() {
+            // A wave of hemi-cube shots; for the hybrid, first ask whether the next shot is
+            // cheaper by rays (Sec. 4: the cost of a hemi-cube shot hardly falls with its
+            // energy, the cost of a ray shot falls in proportion).
+            let mut wave: Vec<CubeShot> = Vec::new();
+            let mut switch = None;
+            while wave.len() < CUBE_WAVE {
+                let Some((i, flux)) = st.peek_shooter() else {
+                    break;
+                };
+                let cube = shooter.cube_for(flux);
+                let forced = cfg.switch_at.is_some_and(|k| stats.shots >= k);
+                let measured = cfg.switch_at.is_none() && cube_cost.samples() >= 2;
+                if method == MethodKind::AdaptiveHybrid && (forced || measured) {
+                    let ctx = ctx.as_ref().expect("checked above");
+                    let per_ray = *ray_cost.get_or_insert_with(|| ctx.probe(i));
+                    let rays = PolarGrid::for_samples(flux / c_ray).len();
+                    let by_cube = cube_cost.predict(cube.cell_count());
+                    let by_rays = rays as f64 * per_ray;
+                    if forced || by_rays < by_cube {
+                        switch = Some(SwitchInfo {
+                            shot: stats.shots,
+                            rays: rays as u64,
+                            seconds_per_ray: per_ray,
+                            hemicube_shot_seconds: by_cube,
+                            ray_shot_seconds: by_rays,
+                            hemicube_cells: cube.cell_count() as u64,
+                            forced,
+                        });
+                        break;
+                    }
+                }
+                let (patch, phi) = st.take_shooter().expect("peeked");
+                wave.push(CubeShot {
+                    patch,
+                    index: stats.shots,
+                    phi,
+                    cube,
+                });
+                stats.shots += 1;
+            }
+            if !wave.is_empty() {
+                let hits: Vec<CubeHits> = shooter.cast(mesh, cfg.seed, &wave);
+                for (shot, h) in wave.iter().zip(&hits) {
+                    cube_cost.add(shot.cube.cell_count(), h.seconds);
+                    cube_shots::apply(&mut st, shot, h);
+                }
+                st.finish_batch();
+                stats.hemicube_shots += wave.len() as u64;
+                stats.waves += 1;
+            }
+            if switch.is_some() {
+                stats.switch = switch;
+                cubes = None;
+            }
+            continue;
+        }
+        let ctx = ctx.as_ref().expect("checked above");
 
         // Take a wave of shooters off the top of the heap (Sec. 2: X = ΔΦ_i / C rays each).
         let mut wave: Vec<Shot> = Vec::new();
         let mut wave_rays = 0usize;
-        let ray_cap = cfg.max_rays.map_or(usize::MAX, |r| {
-            r.saturating_sub(st.rays + in_flight as u64) as usize
-        });
+        let ray_cap = cfg
+            .max_rays
+            .map_or(usize::MAX, |r| r.saturating_sub(samples) as usize);
         while wave_rays < WAVE_RAYS.min(ray_cap.max(1)) {
-            let Some((i, key)) = st.pop_shooter() else {
+            let Some((i, phi)) = st.take_shooter() else {
                 break;
             };
-            let grid = PolarGrid::for_samples(key / c_ray);
+            let grid = PolarGrid::for_samples(scalar(&phi) / c_ray);
             wave_rays += grid.len();
             wave.push(Shot {
                 patch: i,
                 index: stats.shots,
-                phi: st.patches[i].unshot,
+                phi,
                 grid,
             });
-            st.patches[i].unshot = [0.0; 3];
             stats.shots += 1;
         }
         if wave.is_empty() {
             // Nothing to shoot until the wave in flight lands.
             if let Some(p) = pending.take() {
-                st.apply(&p.wave, &p.tasks, &p.hits);
+                apply_rays(&mut st, &p.wave, &p.tasks, &p.hits);
             }
             continue;
         }
@@ -547,59 +442,22 @@ pub fn solve<I: Intersector>(
                 .collect()
         };
         let hits = match pending.take() {
-            Some(p) => rayon::join(|| st.apply(&p.wave, &p.tasks, &p.hits), cast).1,
+            Some(p) => rayon::join(|| apply_rays(&mut st, &p.wave, &p.tasks, &p.hits), cast).1,
             None => cast(),
         };
         pending = Some(Pending { wave, tasks, hits });
         stats.waves += 1;
     };
 
-    for p in &st.patches {
-        add3(&mut st.energy.unshot, &p.unshot);
-    }
+    st.close_books();
     stats.rays = st.rays;
+    stats.hemicube_cells = st.cells;
     stats.energy = st.energy;
     stats.stop_reason = Some(stop_reason);
     stats.seconds = start.elapsed().as_secs_f64();
     Ok(Solution {
-        b: st
-            .patches
-            .iter()
-            .zip(&mesh.patches)
-            .map(|(s, p)| {
-                let e = materials[p.material as usize].emission();
-                [0, 1, 2].map(|c| e[c] + s.gathered[c] / p.area)
-            })
-            .collect(),
+        b: st.radiosity(mesh, materials),
         unshot: st.patches.iter().map(|p| p.unshot).collect(),
         stats,
     })
-}
-
-/// Adds a trace point (and tells the caller).
-fn record(
-    stats: &mut SolveStats,
-    st: &State,
-    elapsed: f64,
-    max_b: f64,
-    mean_b: f64,
-    on_wave: &mut impl FnMut(&TracePoint),
-) {
-    // The heap knows the max only above the stop threshold; a trace point is rare enough to
-    // scan for the exact value.
-    let exact_max = st
-        .patches
-        .iter()
-        .map(|p| scalar(&p.unshot) * p.inv_area as f64)
-        .fold(max_b, f64::max);
-    let p = TracePoint {
-        time_s: elapsed,
-        shots: stats.shots,
-        rays: st.rays,
-        max_unshot_b: exact_max,
-        mean_b,
-        unshot_flux: st.patches.iter().map(|p| scalar(&p.unshot)).sum(),
-    };
-    stats.trace.push(p);
-    on_wave(&p);
 }

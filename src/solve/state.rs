@@ -1,0 +1,307 @@
+//! The shooting solvers' books: per-patch unshot and gathered flux, the priority queues that
+//! pick the next shooter, and the energy accounts. Shared by the ray shooter
+//! ([`super::progressive`]) and the hemi-cube shooter ([`super::cube_shots`]), so every method
+//! keeps the same books and stops by the same criterion (Sec. 3).
+//!
+//! Picking a shooter costs O(log patches): lazily updated binary heaps, one by unshot flux (who
+//! shoots next) and one by unshot radiosity (the stopping criterion), never a scan.
+
+use super::{scalar, EnergyBalance, SolveStats, TracePoint};
+use crate::mesh::Mesh;
+use crate::scene::Material;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// A heap entry: a key and the patch it was computed for. Stale when the patch's current key
+/// differs (the heap is updated lazily: new entries are pushed, old ones skipped when popped).
+#[derive(Clone, Copy, PartialEq)]
+pub(super) struct Entry(pub f64, pub u32);
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Entry {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.0.total_cmp(&o.0).then(o.1.cmp(&self.1))
+    }
+}
+
+/// Max-heap of patches by a key, with lazy deletion.
+#[derive(Default)]
+pub(super) struct LazyHeap {
+    heap: BinaryHeap<Entry>,
+}
+
+impl LazyHeap {
+    fn push(&mut self, key: f64, i: usize) {
+        if key > 0.0 {
+            self.heap.push(Entry(key, i as u32));
+        }
+    }
+    /// The top entry still current under `key_of`, dropping stale ones.
+    fn peek(&mut self, key_of: impl Fn(usize) -> f64) -> Option<Entry> {
+        while let Some(&top) = self.heap.peek() {
+            if key_of(top.1 as usize) == top.0 {
+                return Some(top);
+            }
+            self.heap.pop();
+        }
+        None
+    }
+    /// Rebuilds from scratch when stale entries pile up (keeps memory O(patches)).
+    fn compact(&mut self, n: usize, key_of: impl Fn(usize) -> f64) {
+        if self.heap.len() > 4 * n + 1024 {
+            self.heap = (0..n)
+                .map(|i| Entry(key_of(i), i as u32))
+                .filter(|e| e.0 > 0.0)
+                .collect();
+        }
+    }
+}
+
+/// a += b, per channel.
+#[inline]
+pub(super) fn add3(a: &mut [f64; 3], b: &[f64; 3]) {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
+}
+
+/// Per-patch solver state, packed into one cache line so applying a hit costs one miss.
+/// Energies are f64; ρ and 1/A are stored as f32 (exact enough for a reflectance, and the
+/// energy books stay exact because what is absorbed is computed as Φ − ρΦ in f64).
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(super) struct PatchState {
+    /// Unshot flux ΔΦ_j (W).
+    pub unshot: [f64; 3],
+    /// Flux received and kept (ρ_j × what arrived), W: B_j = E_j + gathered/A_j.
+    pub gathered: [f64; 3],
+    pub rho: [f32; 3],
+    pub inv_area: f32,
+}
+
+/// The solver's mutable state: patches, heaps and energy accounts.
+pub(super) struct State {
+    pub patches: Vec<PatchState>,
+    by_flux: LazyHeap,
+    by_b: LazyHeap,
+    pub energy: EnergyBalance,
+    /// Σ B_j·A_j, for the mean radiosity.
+    pub b_flux: [f64; 3],
+    touched: Vec<bool>,
+    touched_list: Vec<u32>,
+    /// Rays cast and applied.
+    pub rays: u64,
+    /// Hemi-cube cells (form-factor samples) of the shots applied.
+    pub cells: u64,
+    stop_fraction: f64,
+    pub total_area: f64,
+}
+
+impl State {
+    /// Every patch's unshot flux is its emission E·A (Sec. 1: the lights shoot first).
+    pub fn new(mesh: &Mesh, materials: &[Material], stop_fraction: f64) -> State {
+        let n = mesh.patches.len();
+        let patches: Vec<PatchState> = mesh
+            .patches
+            .iter()
+            .map(|p| {
+                let m = &materials[p.material as usize];
+                PatchState {
+                    unshot: m.emission().map(|x| x * p.area),
+                    gathered: [0.0; 3],
+                    rho: m.rho.map(|r| r as f32),
+                    inv_area: (1.0 / p.area) as f32,
+                }
+            })
+            .collect();
+        let mut st = State {
+            patches,
+            by_flux: LazyHeap::default(),
+            by_b: LazyHeap::default(),
+            energy: EnergyBalance::default(),
+            b_flux: [0.0; 3],
+            touched: vec![false; n],
+            touched_list: Vec::new(),
+            rays: 0,
+            cells: 0,
+            stop_fraction,
+            total_area: mesh.total_area(),
+        };
+        for i in 0..n {
+            let p = st.patches[i];
+            add3(&mut st.energy.emitted, &p.unshot);
+            add3(&mut st.b_flux, &p.unshot);
+            let (kf, kb) = (st.key_flux(i), st.key_b(i));
+            st.by_flux.push(kf, i);
+            st.by_b.push(kb, i);
+        }
+        st
+    }
+
+    #[inline]
+    fn key_flux(&self, i: usize) -> f64 {
+        scalar(&self.patches[i].unshot)
+    }
+    #[inline]
+    fn key_b(&self, i: usize) -> f64 {
+        scalar(&self.patches[i].unshot) * self.patches[i].inv_area as f64
+    }
+
+    /// Area-weighted mean radiosity (scalar), W/m².
+    pub fn mean_b(&self) -> f64 {
+        scalar(&self.b_flux) / self.total_area
+    }
+
+    /// Max unshot radiosity (scalar) over the patches above the stop threshold, from the heap
+    /// (0 when none is above it).
+    pub fn max_unshot_b(&mut self) -> f64 {
+        let patches = &self.patches;
+        self.by_b
+            .peek(|i| scalar(&patches[i].unshot) * patches[i].inv_area as f64)
+            .map_or(0.0, |e| e.0)
+    }
+
+    /// Is any unshot energy left?
+    pub fn has_unshot(&mut self) -> bool {
+        let patches = &self.patches;
+        self.by_flux.peek(|i| scalar(&patches[i].unshot)).is_some()
+    }
+
+    /// The patch with the most unshot flux and that flux (scalar), left on the heap.
+    pub fn peek_shooter(&mut self) -> Option<(usize, f64)> {
+        let patches = &self.patches;
+        let top = self.by_flux.peek(|i| scalar(&patches[i].unshot))?;
+        Some((top.1 as usize, top.0))
+    }
+
+    /// Takes the patch with the most unshot flux: returns it and its unshot flux (RGB), which
+    /// is zeroed here (it is about to be shot).
+    pub fn take_shooter(&mut self) -> Option<(usize, [f64; 3])> {
+        let (i, _) = self.peek_shooter()?;
+        self.by_flux.heap.pop();
+        Some((i, std::mem::take(&mut self.patches[i].unshot)))
+    }
+
+    /// Flux `phi` arrives on the front of patch `j`: ρ_j·phi is kept (and will be shot on),
+    /// the rest absorbed.
+    #[inline]
+    pub fn deposit(&mut self, j: usize, phi: &[f64; 3]) {
+        let p = &mut self.patches[j];
+        for (c, &phi) in phi.iter().enumerate() {
+            let kept = p.rho[c] as f64 * phi;
+            p.unshot[c] += kept;
+            p.gathered[c] += kept;
+            self.b_flux[c] += kept;
+            self.energy.absorbed[c] += phi - kept;
+        }
+        if !self.touched[j] {
+            self.touched[j] = true;
+            self.touched_list.push(j as u32);
+        }
+    }
+
+    /// Flux that arrived on a back face (absorbed there).
+    #[inline]
+    pub fn deposit_back(&mut self, phi: &[f64; 3]) {
+        add3(&mut self.energy.absorbed_back, phi);
+    }
+
+    /// Flux that left an open scene.
+    #[inline]
+    pub fn escape(&mut self, phi: &[f64; 3]) {
+        add3(&mut self.energy.escaped, phi);
+    }
+
+    /// Ends a batch of deposits: new heap entries for every patch whose unshot energy grew.
+    /// The max-ΔB heap only needs patches that could block convergence: the threshold
+    /// f·mean(B) never falls (B only grows), so a patch below it now matters again only once
+    /// it grows, and then it is pushed again.
+    pub fn finish_batch(&mut self) {
+        let threshold = self.stop_fraction * self.mean_b();
+        let list = std::mem::take(&mut self.touched_list);
+        for &j in &list {
+            let j = j as usize;
+            self.touched[j] = false;
+            let (kf, kb) = (self.key_flux(j), self.key_b(j));
+            self.by_flux.push(kf, j);
+            if kb >= threshold {
+                self.by_b.push(kb, j);
+            }
+        }
+        self.touched_list = list;
+        self.touched_list.clear();
+        let n = self.patches.len();
+        let patches = &self.patches;
+        self.by_flux.compact(n, |i| scalar(&patches[i].unshot));
+        self.by_b.compact(n, |i| {
+            scalar(&patches[i].unshot) * patches[i].inv_area as f64
+        });
+    }
+
+    /// Radiosity per patch: B_j = E_j + gathered_j / A_j.
+    pub fn radiosity(&self, mesh: &Mesh, materials: &[Material]) -> Vec<[f64; 3]> {
+        self.patches
+            .iter()
+            .zip(&mesh.patches)
+            .map(|(s, p)| {
+                let e = materials[p.material as usize].emission();
+                [0, 1, 2].map(|c| e[c] + s.gathered[c] / p.area)
+            })
+            .collect()
+    }
+
+    /// Moves what is still unshot into the books (at the end of a solve).
+    pub fn close_books(&mut self) {
+        let mut unshot = [0.0; 3];
+        for p in &self.patches {
+            add3(&mut unshot, &p.unshot);
+        }
+        self.energy.unshot = unshot;
+    }
+
+    /// Adds a trace point (and tells the caller). The heap knows the max only above the stop
+    /// threshold; a trace point is rare enough to scan for the exact value.
+    pub fn record(
+        &self,
+        stats: &mut SolveStats,
+        elapsed: f64,
+        max_b: f64,
+        on_trace: &mut impl FnMut(&TracePoint),
+    ) {
+        let exact_max = self
+            .patches
+            .iter()
+            .map(|p| scalar(&p.unshot) * p.inv_area as f64)
+            .fold(max_b, f64::max);
+        let p = TracePoint {
+            time_s: elapsed,
+            shots: stats.shots,
+            rays: self.rays,
+            cells: self.cells,
+            max_unshot_b: exact_max,
+            mean_b: self.mean_b(),
+            unshot_flux: self.patches.iter().map(|p| scalar(&p.unshot)).sum(),
+        };
+        stats.trace.push(p);
+        on_trace(&p);
+    }
+}
+
+/// splitmix64: decorrelates (seed, shot, chunk) into independent RNG seeds.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The random numbers of one shot's chunk of samples: a function of (seed, shot, chunk) only,
+/// so results do not depend on which thread draws them.
+pub(super) fn rng_for(seed: u64, shot: u64, chunk: u64) -> rand_pcg::Pcg64Mcg {
+    use rand::SeedableRng;
+    rand_pcg::Pcg64Mcg::seed_from_u64(mix(mix(mix(seed) ^ shot) ^ chunk))
+}
