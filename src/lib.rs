@@ -20,6 +20,7 @@ pub mod render;
 pub mod report;
 pub mod sample;
 pub mod scene;
+pub mod shot_bench;
 pub mod solve;
 
 pub use error::Error;

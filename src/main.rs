@@ -85,6 +85,24 @@ enum BenchCommand {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Cost per shot (Sec. 4): uniform against non-uniform hemi-cubes with the same largest
+    /// delta form factor, ray shots per ray, and where adaptive-hybrid switches.
+    Shots {
+        scene: Option<PathBuf>,
+        #[command(flatten)]
+        scene_args: SceneArgs,
+        #[command(flatten)]
+        solve_args: SolverArgs,
+        /// Uniform hemi-cube resolutions to compare.
+        #[arg(long, value_delimiter = ',', default_value = "25,50,100,200")]
+        resolutions: Vec<usize>,
+        /// Patches to shoot from (spread over the scene), the same for every sampler.
+        #[arg(long, default_value_t = 64)]
+        shooters: usize,
+        /// Also write the figures as JSON to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// How the scene is read and cut into patches.
@@ -398,6 +416,35 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 );
             } else {
                 print!("{info}");
+            }
+            Ok(())
+        }
+        Command::Bench(BenchCommand::Shots {
+            scene,
+            scene_args,
+            solve_args,
+            resolutions,
+            shooters,
+            out,
+        }) => {
+            if let Some(&bad) = resolutions.iter().find(|&&n| !(2..=4096).contains(&n)) {
+                return Err(radiosity::Error::Invalid(format!(
+                    "--resolutions must be between 2 and 4096, got {bad}"
+                )));
+            }
+            let b = radiosity::shot_bench::bench_shots(
+                &source(scene),
+                &scene_args.load(),
+                &scene_args.mesh(),
+                &solve_args.config()?,
+                &resolutions,
+                shooters,
+            )?;
+            print!("{}", b.markdown());
+            if let Some(path) = out {
+                radiosity::export::write_atomic(&path, |w| {
+                    serde_json::to_writer_pretty(&mut *w, &b).map_err(std::io::Error::other)
+                })?;
             }
             Ok(())
         }

@@ -183,6 +183,43 @@ impl<I: Intersector> Ctx<'_, I> {
     }
 }
 
+/// Thread time per ray (s) of ray shots from `shooters`, `rays_per_shot` each, cast on the
+/// calling thread exactly as the solver casts them (points over the patch, polar cells,
+/// rotation) but not applied: Sec. 4's cost of ray sampling, for the shot-cost benchmark.
+pub fn seconds_per_ray<I: Intersector>(
+    mesh: &Mesh,
+    isect: &I,
+    shooters: &[usize],
+    rays_per_shot: usize,
+    seed: u64,
+) -> f64 {
+    let ctx = Ctx {
+        mesh,
+        isect,
+        seed,
+        jitter: true,
+        eps_floor: mesh
+            .vertices
+            .iter()
+            .fold(0.0f32, |m, v| m.max(v.abs().max_element()))
+            * 5e-7,
+    };
+    let t = Instant::now();
+    let mut rays = 0;
+    for (k, &i) in shooters.iter().enumerate() {
+        let shot = Shot {
+            patch: i,
+            index: k as u64,
+            phi: [0.0; 3],
+            grid: PolarGrid::for_samples(rays_per_shot as f64),
+        };
+        for task in tasks_of(std::slice::from_ref(&shot)) {
+            rays += ctx.cast(&shot, task.chunk, task.first, task.count).len();
+        }
+    }
+    t.elapsed().as_secs_f64() / rays.max(1) as f64
+}
+
 /// Applies a wave's hits in task order: receivers gain ρ_j·ΔΦ_i/X, the rest is absorbed.
 fn apply_rays(st: &mut State, wave: &[Shot], tasks: &[Task], hits: &[Vec<u32>]) {
     for (task, codes) in tasks.iter().zip(hits) {
