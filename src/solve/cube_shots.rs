@@ -121,18 +121,25 @@ impl CubeShooter {
         cube
     }
 
-    /// Renders a wave of shots in parallel; results in shot order.
-    pub fn cast(&self, mesh: &Mesh, seed: u64, wave: &[CubeShot]) -> Vec<CubeHits> {
+    /// Renders a wave of shots in parallel into `hits` (one per shot, in shot order; the
+    /// vectors are reused from wave to wave, so a shot allocates nothing once they are sized).
+    pub fn cast(&self, mesh: &Mesh, seed: u64, wave: &[CubeShot], hits: &mut Vec<CubeHits>) {
         let jitter = matches!(self.kind, CubeKind::Uniform { jitter: true, .. });
+        if hits.len() < wave.len() {
+            hits.resize_with(wave.len(), || CubeHits {
+                ff: Vec::new(),
+                seconds: 0.0,
+            });
+        }
         wave.par_iter()
-            .map(|shot| {
+            .zip(hits.par_iter_mut())
+            .for_each(|(shot, out)| {
                 let t = Instant::now();
                 let p = &mesh.patches[shot.patch];
                 // Sec. 3: a random rotation about the normal per shot (Cohen & Greenberg).
                 let mut rng = rng_for(seed, shot.index, u64::MAX);
                 let frame = Frame::new(p.normal, rng.gen::<f32>() * std::f32::consts::TAU);
                 let mut jitter_rng = rng_for(seed, shot.index, 0);
-                let mut ff = Vec::new();
                 BUFFER.with_borrow_mut(|buf| {
                     shot.cube.shoot(
                         mesh,
@@ -141,15 +148,11 @@ impl CubeShooter {
                         &frame,
                         jitter.then_some(&mut jitter_rng),
                         buf,
-                        &mut ff,
+                        &mut out.ff,
                     )
                 });
-                CubeHits {
-                    ff,
-                    seconds: t.elapsed().as_secs_f64(),
-                }
-            })
-            .collect()
+                out.seconds = t.elapsed().as_secs_f64();
+            });
     }
 }
 

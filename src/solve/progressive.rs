@@ -336,6 +336,7 @@ pub fn shoot<I: Intersector>(
         MethodKind::AdaptiveRays | MethodKind::Gathering => None,
     };
     let mut cube_cost = CubeCost::default();
+    let mut cube_hits: Vec<CubeHits> = Vec::new();
     let mut ray_cost: Option<f64> = None;
 
     let mut stats = SolveStats {
@@ -425,8 +426,8 @@ pub fn shoot<I: Intersector>(
                 stats.shots += 1;
             }
             if !wave.is_empty() {
-                let hits: Vec<CubeHits> = shooter.cast(mesh, cfg.seed, &wave);
-                for (shot, h) in wave.iter().zip(&hits) {
+                shooter.cast(mesh, cfg.seed, &wave, &mut cube_hits);
+                for (shot, h) in wave.iter().zip(&cube_hits) {
                     cube_cost.add(shot.cube.cell_count(), h.seconds);
                     cube_shots::apply(&mut st, shot, h);
                 }
