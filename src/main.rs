@@ -78,9 +78,13 @@ enum BenchCommand {
         scene_args: SceneArgs,
         #[command(flatten)]
         solve_args: SolverArgs,
-        /// Random rays for the raw measurement.
+        /// Random rays for the raw measurement (a quarter before each solve).
         #[arg(long, default_value_t = 4_000_000)]
         rays: u64,
+        /// Solve again (next seeds) until the solves took this long in all, alternating with
+        /// raw measurements, so both see the same machine.
+        #[arg(long, default_value_t = 3.0, value_name = "SECONDS")]
+        min_seconds: f64,
         /// Also write the figures as JSON to this file.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -453,27 +457,35 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
             scene_args,
             solve_args,
             rays,
+            min_seconds,
             out,
         }) => {
+            if !(min_seconds >= 0.0 && min_seconds.is_finite()) {
+                return Err(radiosity::Error::Invalid(format!(
+                    "--min-seconds must be a non-negative number, got {min_seconds}"
+                )));
+            }
             let b = pipeline::bench_rays(
                 &source(scene),
                 &scene_args.load(),
                 &scene_args.mesh(),
                 &solve_args.config()?,
                 rays,
+                min_seconds,
             )?;
             println!(
-                "{}: {} triangles, {} patches, {} threads\n  raw Embree closest hit: {:.2} Mrays/s ({} rays; {:.2} before, {:.2} after the solve)\n  solver:                 {:.2} Mrays/s ({} rays)\n  solver / raw:           {:.0} %",
+                "{}: {} triangles, {} patches, {} threads\n  raw Embree closest hit: {:.2} Mrays/s ({} rays; {:.2} to {:.2} over the run)\n  solver:                 {:.2} Mrays/s ({} rays in {} solves)\n  solver / raw:           {:.0} %",
                 b.scene,
                 b.triangles,
                 b.patches,
                 b.threads,
                 b.raw_rays_per_second / 1e6,
                 b.raw_rays,
-                b.raw_before_after[0] / 1e6,
-                b.raw_before_after[1] / 1e6,
+                b.raw_min_max[0] / 1e6,
+                b.raw_min_max[1] / 1e6,
                 b.solver_rays_per_second / 1e6,
                 b.solver_rays,
+                b.solves,
                 100.0 * b.ratio
             );
             if let Some(path) = out {

@@ -315,9 +315,12 @@ pub struct RayBench {
     /// directions uniform on the sphere), all threads.
     pub raw_rays_per_second: f64,
     pub raw_rays: u64,
-    /// The raw rate measured before and after the solve.
-    pub raw_before_after: [f64; 2],
-    /// Rays per second of the solver's whole solve phase (sampling, casting, bookkeeping).
+    /// The slowest and fastest of the raw measurements (one before each solve, one after the
+    /// last): how much the machine's speed drifted during the run.
+    pub raw_min_max: [f64; 2],
+    /// Solves run (seeds seed, seed + 1, …) to fill the requested solve time.
+    pub solves: usize,
+    /// Rays per second of the solver's whole solve phases (sampling, casting, bookkeeping).
     pub solver_rays_per_second: f64,
     pub solver_rays: u64,
     /// solver / raw.
@@ -368,6 +371,7 @@ pub fn bench_rays(
     mesh_opts: &MeshOptions,
     cfg: &SolveConfig,
     raw_rays: u64,
+    min_seconds: f64,
 ) -> Result<RayBench, Error> {
     // The solver's rays are what is measured: the ray shooter, whatever --method says.
     let cfg = &SolveConfig {
@@ -378,19 +382,43 @@ pub fn bench_rays(
     let m = mesh::build(&scene, mesh_opts);
     let isect = EmbreeScene::build(&m, |_| true)?;
     let (lo, hi) = scene.bounds();
-    // Warm up (page in the BVH, spin up the threads), then measure the raw rate before and
-    // after the solve, so a drift of the machine's speed shows and averages out.
+    // Warm up (page in the BVH, spin up the threads). Then alternate raw measurements and
+    // solves (seeds seed, seed + 1, …) until the solves add up to `min_seconds`, ending with
+    // a raw one: a drift of the machine's speed (it is shared) then hits both sides alike.
     raw_throughput(&isect, lo, hi, raw_rays / 10 + 1, cfg.seed);
-    let (n1, s1) = raw_throughput(&isect, lo, hi, raw_rays / 2, cfg.seed);
-    let sol =
-        solve::solve(&m, &scene.materials, &isect, cfg, |_| {}).map_err(|source| Error::Solve {
-            scene: scene.name.clone(),
-            source,
+    let rounds_raw = (raw_rays / 4).max(4096);
+    let mut raw_rates = Vec::new();
+    let (mut n_raw, mut s_raw) = (0u64, 0.0f64);
+    let (mut solver_rays, mut solver_s, mut solves) = (0u64, 0.0f64, 0usize);
+    loop {
+        let (n, s) = raw_throughput(&isect, lo, hi, rounds_raw, cfg.seed ^ solves as u64);
+        raw_rates.push(n as f64 / s.max(1e-9));
+        (n_raw, s_raw) = (n_raw + n, s_raw + s);
+        if solves > 0 && (solver_s >= min_seconds || solves >= 100) {
+            break;
+        }
+        let round = SolveConfig {
+            seed: cfg.seed.wrapping_add(solves as u64),
+            ..cfg.clone()
+        };
+        let sol = solve::solve(&m, &scene.materials, &isect, &round, |_| {}).map_err(|source| {
+            Error::Solve {
+                scene: scene.name.clone(),
+                source,
+            }
         })?;
-    let (n2, s2) = raw_throughput(&isect, lo, hi, raw_rays / 2, cfg.seed ^ 1);
-    let (n_raw, s_raw) = (n1 + n2, s1 + s2);
+        solver_rays += sol.stats.rays;
+        solver_s += sol.stats.seconds;
+        solves += 1;
+    }
     let raw = n_raw as f64 / s_raw.max(1e-9);
-    let solver = sol.stats.rays as f64 / sol.stats.seconds.max(1e-9);
+    let solver = solver_rays as f64 / solver_s.max(1e-9);
+    let spread = |v: &[f64]| {
+        [
+            v.iter().copied().fold(f64::INFINITY, f64::min),
+            v.iter().copied().fold(0.0, f64::max),
+        ]
+    };
     Ok(RayBench {
         scene: scene.name.clone(),
         triangles: isect.triangle_count(),
@@ -398,9 +426,10 @@ pub fn bench_rays(
         threads: rayon::current_num_threads(),
         raw_rays_per_second: raw,
         raw_rays: n_raw,
-        raw_before_after: [n1 as f64 / s1.max(1e-9), n2 as f64 / s2.max(1e-9)],
+        raw_min_max: spread(&raw_rates),
+        solves,
         solver_rays_per_second: solver,
-        solver_rays: sol.stats.rays,
+        solver_rays,
         ratio: solver / raw,
     })
 }
