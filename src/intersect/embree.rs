@@ -5,7 +5,9 @@
 //! `rtcIntersect1` needs, and — measured here — its `intersect_1` is unsound against Embree
 //! 4.3+: the library writes `instPrimID` (4 bytes, seen as 0xffffffff) past the end of the
 //! `RTCRayHit` laid out from the 4.2 headers, i.e. past its stack variable. [`RayHitSlack`]
-//! gives that write somewhere to land. Patches are fanned into triangles; `prim_patch` maps Embree's primitive ids back.
+//! gives that write somewhere to land. Its `Device` cannot be used on its own either: the
+//! handle is crate-private (so no scene of ours can be made on it), the type is `!Send`, and
+//! `Device::try_new` hands `rtcNewDevice` a Rust `&str` that is not NUL-terminated. Patches are fanned into triangles; `prim_patch` maps Embree's primitive ids back.
 //! The scene is built with `RTC_SCENE_FLAG_ROBUST` so rays do not slip through shared edges of a
 //! closed room (measured: without it, a few rays per million escape a closed box).
 #![allow(unsafe_code)]
