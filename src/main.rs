@@ -214,6 +214,10 @@ struct SolveArgs {
     /// Output folder.
     #[arg(long, default_value = "out")]
     out: PathBuf,
+    /// A reference patch table (a patches.csv of the same scene and patch size, e.g. from
+    /// `radiosity reference`): the trace then records the error against it.
+    #[arg(long, value_name = "PATCHES.csv")]
+    reference: Option<PathBuf>,
     /// Camera position X,Y,Z (default: fitted to the scene, looking along −z).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
@@ -323,6 +327,7 @@ impl SolverArgs {
             hemicube_n: self.hemicube_n,
             gather_cap_mib: self.gather_cap_mib,
             switch_at: self.switch_at,
+            reference: None,
         })
     }
 }
@@ -336,6 +341,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 mesh: a.scene_args.mesh(),
                 solve: a.solve_args.config()?,
                 out: a.out.clone(),
+                reference: a.reference.clone(),
                 camera: CameraSpec {
                     eye: a.eye,
                     target: a.target,
@@ -371,6 +377,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                     summary.energy.relative_residual,
                     a.out.display()
                 );
+                println!("{}", summary.error_line());
             }
             Ok(())
         }

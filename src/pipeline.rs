@@ -63,6 +63,8 @@ pub struct SolveJob {
     pub out: PathBuf,
     pub camera: CameraSpec,
     pub render: RenderOptions,
+    /// A reference patch table (`--reference`): the trace then records the error against it.
+    pub reference: Option<PathBuf>,
 }
 
 /// Loads the scene named by `source`.
@@ -127,6 +129,41 @@ pub fn validate(job: &SolveJob) -> Result<(), Error> {
     Ok(())
 }
 
+/// Reads a reference patch table and checks it belongs to this mesh (same patch count, and
+/// every patch's centre where this mesh has it). Returns its radiosity per patch.
+pub fn load_reference(path: &std::path::Path, m: &Mesh) -> Result<Vec<[f64; 3]>, Error> {
+    let bad = |what: String| Error::Invalid(format!("--reference {}: {what}", path.display()));
+    let file = std::fs::File::open(path).map_err(|e| bad(format!("cannot read it ({e})")))?;
+    let rows = patches::read(std::io::BufReader::new(file)).map_err(|e| bad(e.to_string()))?;
+    if rows.len() != m.patches.len() {
+        return Err(bad(format!(
+            "it has {} patches but this mesh has {}: solve the reference with the same scene and --patch-size",
+            rows.len(),
+            m.patches.len()
+        )));
+    }
+    let (lo, hi) = m.vertices.iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(l, h), v| (l.min(*v), h.max(*v)),
+    );
+    let tol = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE) as f64 + 1e-6;
+    for (k, (row, p)) in rows.iter().zip(&m.patches).enumerate() {
+        let c = [row.values[0], row.values[1], row.values[2]];
+        let far = (0..3).any(|a| (c[a] - p.centre[a] as f64).abs() > tol);
+        if row.id != k || far {
+            return Err(bad(format!(
+                "patch {k} is not where this mesh has it: the reference comes from another scene or patch size"
+            )));
+        }
+        if row.b().iter().any(|x| !x.is_finite() || *x < 0.0) {
+            return Err(bad(format!(
+                "patch {k} has a radiosity that is not a finite non-negative number"
+            )));
+        }
+    }
+    Ok(rows.iter().map(|r| r.b()).collect())
+}
+
 /// Warnings about a solution a user should hear of.
 fn solution_warnings(energy: &EnergyReport) -> Vec<String> {
     let mut w = Vec::new();
@@ -183,12 +220,16 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
     };
     timings.build = t.elapsed().as_secs_f64();
 
+    let mut cfg = job.solve.clone();
+    if let Some(path) = &job.reference {
+        cfg.reference = Some(std::sync::Arc::new(load_reference(path, &m)?));
+    }
     let t = Instant::now();
     let sol = solve::run(
         &m,
         &scene.materials,
         isect.as_ref(),
-        &job.solve,
+        &cfg,
         |_p: &TracePoint| {},
     )
     .map_err(|source| Error::Solve {
@@ -204,6 +245,9 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
     let csv = job.out.join("patches.csv");
     write_atomic(&csv, |w| patches::write(w, &m, &scene.materials, &sol.b))?;
     outputs.push(csv.display().to_string());
+    let trace_csv = job.out.join("trace.csv");
+    write_atomic(&trace_csv, |w| export::trace::write(w, &sol.stats.trace))?;
+    outputs.push(trace_csv.display().to_string());
 
     let png = job.out.join("render.png");
     let (lo, hi) = scene.bounds();
@@ -264,6 +308,8 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
         seconds: timings,
         energy,
+        error_estimate: last.map(|p| p.estimate).unwrap_or_default(),
+        error: last.and_then(|p| p.error),
         max_unshot_over_mean: last
             .map_or(0.0, |p| p.max_unshot_b / p.mean_b.max(f64::MIN_POSITIVE)),
         warnings,

@@ -2,6 +2,7 @@
 
 use crate::mesh::{Mesh, PatchClass};
 use crate::scene::Scene;
+use crate::solve::error::ErrorMetrics;
 use crate::solve::{scalar, EnergyBalance, SolveStats, StopReason, SwitchInfo, TracePoint};
 use serde::Serialize;
 
@@ -234,6 +235,10 @@ pub struct Summary {
     pub rays_per_second: f64,
     pub seconds: Timings,
     pub energy: EnergyReport,
+    /// The solver's own estimate of its final error (fractions; see `solve::error`).
+    pub error_estimate: ErrorMetrics,
+    /// The final error against `--reference`, when given.
+    pub error: Option<ErrorMetrics>,
     /// Final max unshot radiosity over the mean radiosity (Sec. 3's criterion).
     pub max_unshot_over_mean: f64,
     pub warnings: Vec<String>,
@@ -243,6 +248,25 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// One line: the final error, measured against the reference or estimated.
+    pub fn error_line(&self) -> String {
+        let e = &self.error_estimate;
+        let est = format!(
+            "estimated error {:.2} % (average weighted percent), {:.2} % (average energy)",
+            100.0 * e.weighted_percent,
+            100.0 * e.energy
+        );
+        match &self.error {
+            Some(r) => format!(
+                "error against the reference {:.2} % (average weighted percent), {:.2} % (average energy), {:.2} % RMS; {est}",
+                100.0 * r.weighted_percent,
+                100.0 * r.energy,
+                100.0 * r.rms_relative
+            ),
+            None => est,
+        }
+    }
+
     pub fn stats_line(stats: &SolveStats) -> String {
         let mut line = format!("{} shots", stats.shots);
         if stats.hemicube_shots > 0 {

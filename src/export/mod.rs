@@ -2,6 +2,7 @@
 //! temporary name beside the target, then renamed, so no partial file is left behind.
 
 pub mod patches;
+pub mod trace;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

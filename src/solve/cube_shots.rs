@@ -159,12 +159,14 @@ impl CubeShooter {
 /// Applies one shot: j receives ΔΦ_i·F_ij; what no cell saw escapes.
 pub(super) fn apply(st: &mut State, shot: &CubeShot, hits: &CubeHits) {
     let mut seen = 0.0;
+    // Cells carry ΔΦ/cells on average (equal ΔF for the non-uniform cube).
+    let e_cell = super::scalar(&shot.phi) / shot.cube.cell_count() as f64;
     for &(j, f, back) in &hits.ff {
         let phi = shot.phi.map(|p| p * f);
         if back {
             st.deposit_back(&phi);
         } else {
-            st.deposit(j as usize, &phi);
+            st.deposit_cube(j as usize, &phi, e_cell);
         }
         seen += f;
     }

@@ -94,13 +94,26 @@ pub fn gauss_seidel(
     stop_fraction: f64,
     max_sweeps: usize,
 ) -> (Vec<[f64; 3]>, usize) {
+    gauss_seidel_with(ff, e, rho, area, stop_fraction, max_sweeps, |_, _| {})
+}
+
+/// [`gauss_seidel`], calling `on_sweep(B, |change| per patch)` after every sweep.
+pub fn gauss_seidel_with(
+    ff: &FormFactors,
+    e: &[[f64; 3]],
+    rho: &[[f64; 3]],
+    area: &[f64],
+    stop_fraction: f64,
+    max_sweeps: usize,
+    mut on_sweep: impl FnMut(&[[f64; 3]], &[f64]),
+) -> (Vec<[f64; 3]>, usize) {
     let n = ff.n;
     let mut b: Vec<[f64; 3]> = e.to_vec();
+    let mut change = vec![0.0f64; n];
     let total_area: f64 = area.iter().sum();
     let mut sweeps = 0;
     while sweeps < max_sweeps {
         sweeps += 1;
-        let mut max_change = 0.0f64;
         for i in 0..n {
             let row = ff.row(i);
             let mut gathered = [0.0f64; 3];
@@ -112,16 +125,71 @@ pub fn gauss_seidel(
                 }
             }
             let new = [0, 1, 2].map(|c| e[i][c] + rho[i][c] * gathered[c]);
-            let change = scalar(&[0, 1, 2].map(|c| (new[c] - b[i][c]).abs()));
-            max_change = max_change.max(change);
+            change[i] = scalar(&[0, 1, 2].map(|c| (new[c] - b[i][c]).abs()));
             b[i] = new;
         }
+        on_sweep(&b, &change);
+        let max_change = change.iter().copied().fold(0.0, f64::max);
         let mean: f64 = b.iter().zip(area).map(|(b, a)| scalar(b) * a).sum::<f64>() / total_area;
         if max_change <= stop_fraction * mean {
             break;
         }
     }
     (b, sweeps)
+}
+
+/// Gathering's own error estimate per patch (see [`super::error`]), from three parts:
+/// - the form factors' error, seen through reciprocity: row i (i's hemi-cube) and column i
+///   (A_j·F_ji/A_i, the other hemi-cubes) estimate the same exchange independently, so half
+///   their difference, ρ_i·|Σ_j (F_ij − A_j F_ji/A_i)·B_j| / √2, measures what row i gets wrong
+///   (point sampling from the patch centre, aliasing);
+/// - as a floor, the hemi-cube's Poisson sampling (a cell of mean ΔF = 1/cells:
+///   Var B_i ≈ ρ_i² Σ_j F_ij·B_j² / cells);
+/// - the convergence still to come: the last sweep's change times q/(1 − q), q the sweep to
+///   sweep ratio of the largest change (for the first sweep, the second sweep's change over
+///   1 − q); before the first sweep, all of the reflected light.
+#[allow(clippy::too_many_arguments)]
+fn gathering_estimate(
+    ff: &FormFactors,
+    area: &[f64],
+    rho_s: &[f64],
+    b_s: &[f64],
+    e_s: &[f64],
+    cells: usize,
+    conv: Option<(&[f64], f64)>,
+) -> Vec<f64> {
+    let n = ff.n;
+    // Column sums Σ_j A_j·B_j·F_ji, by a row-major pass.
+    let mut col = vec![0.0f64; n];
+    for j in 0..n {
+        let w = area[j] * b_s[j];
+        for (c, &f) in col.iter_mut().zip(ff.row(j)) {
+            *c += w * f as f64;
+        }
+    }
+    let rho_mean: f64 =
+        rho_s.iter().zip(area).map(|(r, a)| r * a).sum::<f64>() / area.iter().sum::<f64>();
+    let emitted: f64 = e_s.iter().zip(area).map(|(e, a)| e * a).sum();
+    let owed_each = emitted * rho_mean / (1.0 - rho_mean.min(0.999)) / area.iter().sum::<f64>();
+    (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let (mut direct, mut var) = (0.0, 0.0);
+            for (&f, &bj) in ff.row(i).iter().zip(b_s) {
+                direct += f as f64 * bj;
+                var += f as f64 * bj * bj;
+            }
+            let var = rho_s[i] * rho_s[i] * var / cells as f64;
+            let recip = col[i] / area[i];
+            let d = rho_s[i] * (direct - recip).abs() / std::f64::consts::SQRT_2;
+            let form = (d * d).max(std::f64::consts::FRAC_2_PI * var);
+            let conv = match conv {
+                Some((ch, factor)) => ch[i] * factor,
+                None => owed_each,
+            };
+            (conv * conv + form).sqrt()
+        })
+        .collect()
 }
 
 /// Progressive shooting (Southwell iteration, as in Cohen et al. 1988) over the same linear
@@ -174,6 +242,8 @@ pub fn gather(
     n_cube: usize,
     seed: u64,
     stop_fraction: f64,
+    reference: Option<&[[f64; 3]]>,
+    mut on_trace: impl FnMut(&TracePoint),
 ) -> Solution {
     let start = Instant::now();
     let n = mesh.patches.len();
@@ -190,7 +260,69 @@ pub fn gather(
         .map(|p| materials[p.material as usize].rho)
         .collect();
     let matrix_s = start.elapsed().as_secs_f64();
-    let (b, sweeps) = gauss_seidel(&ff, &e, &rho, &area, stop_fraction, 100_000);
+    let cells = Hemicube::uniform(n_cube).cell_count();
+    let rho_s: Vec<f64> = rho.iter().map(scalar).collect();
+    let b_now = |b: &[[f64; 3]]| -> Vec<f64> { b.iter().map(scalar).collect() };
+    let mean_of =
+        |b: &[f64]| b.iter().zip(&area).map(|(b, a)| b * a).sum::<f64>() / mesh.total_area();
+    // Trace points: after the matrix (B = E), then after every sweep.
+    let mut trace = Vec::new();
+    let e_s: Vec<f64> = e.iter().map(scalar).collect();
+    let mut point = |time_s: f64, b: &[[f64; 3]], conv: Option<(&[f64], f64)>| {
+        let bs = b_now(b);
+        let err = gathering_estimate(&ff, &area, &rho_s, &bs, &e_s, cells, conv);
+        // The estimate of the true B: B plus the light still to come.
+        let b_est: Vec<f64> = match conv {
+            Some((ch, factor)) => bs.iter().zip(ch).map(|(b, c)| b + c * factor).collect(),
+            None => bs.iter().zip(&err).map(|(b, e)| b + e).collect(),
+        };
+        let estimate = super::error::from_errors(&area, err.into_iter(), &b_est);
+        let error = reference.map(|r| super::error::against(&area, b, r));
+        let p = TracePoint {
+            time_s,
+            shots: n as u64,
+            rays: 0,
+            cells: (n * cells) as u64,
+            max_unshot_b: 0.0,
+            mean_b: mean_of(&bs),
+            unshot_flux: 0.0,
+            estimate,
+            error,
+        };
+        on_trace(&p);
+        trace.push(p);
+    };
+    // Before any sweep the whole reflected light is missing: count it as the error.
+    point(matrix_s, &e, None);
+    // Gathering has no useful answer before it converges (the paper's point), so its trace is
+    // written when it has: the convergence error of sweep k is then known, |B_k − B_last|, plus
+    // the last sweep's own geometric tail, Δ_last·q/(1 − q) with q the ratio of the last two
+    // sweeps' largest changes.
+    let mut sweeps_seen: Vec<(f64, Vec<[f64; 3]>, f64)> = Vec::new();
+    let mut last_change = vec![0.0; n];
+    let (b, sweeps) =
+        gauss_seidel_with(&ff, &e, &rho, &area, stop_fraction, 100_000, |b, change| {
+            let max = change.iter().copied().fold(0.0, f64::max);
+            sweeps_seen.push((start.elapsed().as_secs_f64(), b.to_vec(), max));
+            last_change.copy_from_slice(change);
+        });
+    let k = sweeps_seen.len();
+    let q = if k >= 2 && sweeps_seen[k - 2].2 > 0.0 {
+        (sweeps_seen[k - 1].2 / sweeps_seen[k - 2].2).min(0.999)
+    } else {
+        0.0
+    };
+    let tail: Vec<f64> = last_change.iter().map(|c| c * q / (1.0 - q)).collect();
+    let b_last: Vec<f64> = b.iter().map(scalar).collect();
+    for (t, bk, _) in &sweeps_seen {
+        let conv: Vec<f64> = bk
+            .iter()
+            .zip(&b_last)
+            .zip(&tail)
+            .map(|((x, l), t)| (scalar(x) - l).abs() + t)
+            .collect();
+        point(*t, bk, Some((&conv, 1.0)));
+    }
 
     // Where the light went, from B: i sends B_i·A_i·F_ij to j.
     let mut energy = EnergyBalance::default();
@@ -215,7 +347,6 @@ pub fn gather(
             energy.absorbed[c] += (1.0 - rho[j][c]) * arrived[j][c];
         }
     }
-    let mean_b = b.iter().zip(&area).map(|(b, a)| scalar(b) * a).sum::<f64>() / mesh.total_area();
     let seconds = start.elapsed().as_secs_f64();
     let stats = SolveStats {
         shots: n as u64,
@@ -227,26 +358,7 @@ pub fn gather(
         energy_per_ray: 0.0,
         stop_reason: Some(StopReason::Converged),
         energy,
-        trace: vec![
-            TracePoint {
-                time_s: matrix_s,
-                shots: n as u64,
-                rays: 0,
-                cells: 0,
-                max_unshot_b: 0.0,
-                mean_b: 0.0,
-                unshot_flux: 0.0,
-            },
-            TracePoint {
-                time_s: seconds,
-                shots: n as u64,
-                rays: 0,
-                cells: 0,
-                max_unshot_b: 0.0,
-                mean_b,
-                unshot_flux: 0.0,
-            },
-        ],
+        trace,
         ..SolveStats::default()
     };
     Solution {

@@ -8,6 +8,7 @@
 //! F_ij estimated by the fraction of rays).
 
 pub mod cube_shots;
+pub mod error;
 pub mod gathering;
 pub mod progressive;
 mod state;
@@ -84,6 +85,9 @@ pub struct SolveConfig {
     /// The measured switch depends on timings, so it can differ between runs; giving the shot
     /// a summary recorded makes the run reproducible exactly.
     pub switch_at: Option<u64>,
+    /// Radiosity per patch of a reference solution (`--reference`): every trace point then
+    /// records the error against it.
+    pub reference: Option<std::sync::Arc<Vec<[f64; 3]>>>,
 }
 
 impl Default for SolveConfig {
@@ -100,6 +104,7 @@ impl Default for SolveConfig {
             hemicube_n: 100,
             gather_cap_mib: 4096,
             switch_at: None,
+            reference: None,
         }
     }
 }
@@ -130,6 +135,10 @@ pub struct TracePoint {
     pub mean_b: f64,
     /// Total unshot flux (scalar), W.
     pub unshot_flux: f64,
+    /// The solver's own estimate of its error (see [`error`]).
+    pub estimate: error::ErrorMetrics,
+    /// The error against the reference, when the solve was given one.
+    pub error: Option<error::ErrorMetrics>,
 }
 
 /// Where the emitted energy went (W per RGB channel). emitted = absorbed + absorbed_back +
@@ -232,6 +241,8 @@ pub enum SolveError {
     TooManyPatches(usize),
     #[error(transparent)]
     GatherTooLarge(#[from] gathering::TooLarge),
+    #[error("the reference has {reference} patches but this mesh has {patches}: solve the reference with the same scene and --patch-size")]
+    ReferenceMismatch { reference: usize, patches: usize },
     #[error("--method {0} casts rays but no intersector was built")]
     NoIntersector(&'static str),
 }
@@ -254,7 +265,7 @@ pub fn run<I: Intersector>(
     materials: &[Material],
     isect: Option<&I>,
     cfg: &SolveConfig,
-    mut on_trace: impl FnMut(&TracePoint),
+    on_trace: impl FnMut(&TracePoint),
 ) -> Result<Solution, SolveError> {
     match cfg.method {
         MethodKind::Gathering => {
@@ -266,10 +277,23 @@ pub fn run<I: Intersector>(
             {
                 return Err(SolveError::NoEmitter);
             }
-            let sol =
-                gathering::gather(mesh, materials, cfg.hemicube_n, cfg.seed, cfg.stop_fraction);
-            sol.stats.trace.iter().for_each(&mut on_trace);
-            Ok(sol)
+            if let Some(r) = &cfg.reference {
+                if r.len() != mesh.patches.len() {
+                    return Err(SolveError::ReferenceMismatch {
+                        reference: r.len(),
+                        patches: mesh.patches.len(),
+                    });
+                }
+            }
+            Ok(gathering::gather(
+                mesh,
+                materials,
+                cfg.hemicube_n,
+                cfg.seed,
+                cfg.stop_fraction,
+                cfg.reference.as_deref().map(Vec::as_slice),
+                on_trace,
+            ))
         }
         _ => progressive::shoot(mesh, materials, isect, cfg, on_trace),
     }

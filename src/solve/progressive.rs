@@ -16,6 +16,7 @@
 //! threads.
 
 use super::cube_shots::{self, CubeCost, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WAVE};
+use super::error::Estimator;
 use super::state::{rng_for, State};
 use super::{
     scalar, MethodKind, Solution, SolveConfig, SolveError, SolveStats, StopReason, SwitchInfo,
@@ -299,6 +300,14 @@ pub fn shoot<I: Intersector>(
     if scalar(&st.energy.emitted) <= 0.0 {
         return Err(SolveError::NoEmitter);
     }
+    if let Some(r) = &cfg.reference {
+        if r.len() != n {
+            return Err(SolveError::ReferenceMismatch {
+                reference: r.len(),
+                patches: n,
+            });
+        }
+    }
     let rho: Vec<[f64; 3]> = mesh
         .patches
         .iter()
@@ -309,6 +318,25 @@ pub fn shoot<I: Intersector>(
         .filter(|c| *c > 0.0)
         .unwrap_or_else(|| energy_per_ray(mesh, &rho, scalar(&st.energy.emitted), cfg.tolerance));
     drop(rho);
+    let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
+    let emission: Vec<f64> = mesh
+        .patches
+        .iter()
+        .map(|p| scalar(&materials[p.material as usize].emission()))
+        .collect();
+    let rho_s: Vec<f64> = mesh
+        .patches
+        .iter()
+        .map(|p| scalar(&materials[p.material as usize].rho))
+        .collect();
+    let est = Estimator {
+        area: &area,
+        emission: &emission,
+        rho: &rho_s,
+        energy_per_ray: c_ray,
+        rho_mean: rho_s.iter().zip(&area).map(|(r, a)| r * a).sum::<f64>() / mesh.total_area(),
+    };
+    let reference = cfg.reference.as_deref().map(Vec::as_slice);
 
     let (lo, hi) = mesh.vertices.iter().fold(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
@@ -345,6 +373,7 @@ pub fn shoot<I: Intersector>(
     };
     let mut pending: Option<Pending> = None;
     let mut next_trace = 0.0f64;
+    let mut next_trace_shots = 0u64;
     let stop_reason = loop {
         // Sec. 3's criterion, then the budgets.
         let max_b = st.max_unshot_b();
@@ -376,12 +405,34 @@ pub fn shoot<I: Intersector>(
                 apply_rays(&mut st, &p.wave, &p.tasks, &p.hits);
                 continue;
             }
-            st.record(&mut stats, elapsed, max_b, &mut on_trace);
+            st.record(
+                &mut stats,
+                elapsed,
+                max_b,
+                &est,
+                reference,
+                0.0,
+                &mut on_trace,
+            );
             break r;
         }
-        if elapsed >= next_trace {
-            st.record(&mut stats, elapsed, max_b, &mut on_trace);
+        // Trace points at geometric steps of time and of shots (even spacing on the log-log
+        // plots of error against time).
+        if elapsed >= next_trace || stats.shots >= next_trace_shots {
+            let flying = pending
+                .as_ref()
+                .map_or(0.0, |p| p.wave.iter().map(|s| scalar(&s.phi)).sum::<f64>());
+            st.record(
+                &mut stats,
+                elapsed,
+                max_b,
+                &est,
+                reference,
+                flying,
+                &mut on_trace,
+            );
             next_trace = (elapsed * 1.25).max(elapsed + 0.002);
+            next_trace_shots = (stats.shots as f64 * 1.25) as u64 + 8;
         }
 
         if let Some(shooter) = cubes.as_mut() {

@@ -6,6 +6,7 @@
 //! Picking a shooter costs O(log patches): lazily updated binary heaps, one by unshot flux (who
 //! shoots next) and one by unshot radiosity (the stopping criterion), never a scan.
 
+use super::error::{self, Books, Estimator};
 use super::{scalar, EnergyBalance, SolveStats, TracePoint};
 use crate::mesh::Mesh;
 use crate::scene::Material;
@@ -99,6 +100,12 @@ pub(super) struct State {
     pub cells: u64,
     stop_fraction: f64,
     pub total_area: f64,
+    /// Scalar flux taken off the queue to be shot so far.
+    pub shot_flux: f64,
+    /// Of each patch's kept flux, what hemi-cube shots left (scalar), and its sampling
+    /// variance Σ ρ·e_cell·kept (see [`super::error`]). Empty until a hemi-cube shot lands.
+    cube_gathered: Vec<f64>,
+    cube_var: Vec<f64>,
 }
 
 impl State {
@@ -130,6 +137,9 @@ impl State {
             cells: 0,
             stop_fraction,
             total_area: mesh.total_area(),
+            shot_flux: 0.0,
+            cube_gathered: Vec::new(),
+            cube_var: Vec::new(),
         };
         for i in 0..n {
             let p = st.patches[i];
@@ -181,8 +191,9 @@ impl State {
     /// Takes the patch with the most unshot flux: returns it and its unshot flux (RGB), which
     /// is zeroed here (it is about to be shot).
     pub fn take_shooter(&mut self) -> Option<(usize, [f64; 3])> {
-        let (i, _) = self.peek_shooter()?;
+        let (i, flux) = self.peek_shooter()?;
         self.by_flux.heap.pop();
+        self.shot_flux += flux;
         Some((i, std::mem::take(&mut self.patches[i].unshot)))
     }
 
@@ -202,6 +213,21 @@ impl State {
             self.touched[j] = true;
             self.touched_list.push(j as u32);
         }
+    }
+
+    /// [`Self::deposit`] from a hemi-cube shot whose cells carry `e_cell` (scalar W) each on
+    /// average: also books the sampling variance it adds.
+    #[inline]
+    pub fn deposit_cube(&mut self, j: usize, phi: &[f64; 3], e_cell: f64) {
+        if self.cube_gathered.is_empty() {
+            self.cube_gathered = vec![0.0; self.patches.len()];
+            self.cube_var = vec![0.0; self.patches.len()];
+        }
+        let rho = self.patches[j].rho.map(f64::from);
+        let kept = scalar(&[0, 1, 2].map(|c| rho[c] * phi[c]));
+        self.cube_gathered[j] += kept;
+        self.cube_var[j] += scalar(&rho) * e_cell * kept;
+        self.deposit(j, phi);
     }
 
     /// Flux that arrived on a back face (absorbed there).
@@ -263,13 +289,18 @@ impl State {
         self.energy.unshot = unshot;
     }
 
-    /// Adds a trace point (and tells the caller). The heap knows the max only above the stop
+    /// Adds a trace point (and tells the caller): the solver's own error estimate always, the
+    /// error against `reference` when there is one. The heap knows the max only above the stop
     /// threshold; a trace point is rare enough to scan for the exact value.
+    #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
         stats: &mut SolveStats,
         elapsed: f64,
         max_b: f64,
+        est: &Estimator,
+        reference: Option<&[[f64; 3]]>,
+        in_flight: f64,
         on_trace: &mut impl FnMut(&TracePoint),
     ) {
         let exact_max = self
@@ -277,6 +308,26 @@ impl State {
             .iter()
             .map(|p| scalar(&p.unshot) * p.inv_area as f64)
             .fold(max_b, f64::max);
+        let unshot_flux: f64 = self.patches.iter().map(|p| scalar(&p.unshot)).sum();
+        let gathered: Vec<f64> = self.patches.iter().map(|p| scalar(&p.gathered)).collect();
+        let estimate = est.metrics(&Books {
+            gathered: &gathered,
+            cube_gathered: &self.cube_gathered,
+            cube_var: &self.cube_var,
+            kept: gathered.iter().sum(),
+            // A wave cast but not applied yet is still light to come.
+            unshot: unshot_flux + in_flight,
+            shot: self.shot_flux - in_flight,
+        });
+        let error = reference.map(|r| {
+            let b: Vec<[f64; 3]> = gathered
+                .iter()
+                .zip(est.emission)
+                .zip(est.area)
+                .map(|((g, e), a)| [e + g / a; 3])
+                .collect();
+            error::against(est.area, &b, r)
+        });
         let p = TracePoint {
             time_s: elapsed,
             shots: stats.shots,
@@ -284,7 +335,9 @@ impl State {
             cells: self.cells,
             max_unshot_b: exact_max,
             mean_b: self.mean_b(),
-            unshot_flux: self.patches.iter().map(|p| scalar(&p.unshot)).sum(),
+            unshot_flux,
+            estimate,
+            error,
         };
         stats.trace.push(p);
         on_trace(&p);
