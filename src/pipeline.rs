@@ -2,7 +2,7 @@
 //! write the patch table, the image and the JSON summary. The binary only fills a [`SolveJob`].
 
 use crate::export::{self, patches, write_atomic};
-use crate::intersect::embree::EmbreeScene;
+use crate::intersect::select::{self, IntersectorKind};
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::{self, Mesh, MeshOptions};
 use crate::render::{self, Camera, RenderOptions};
@@ -61,6 +61,8 @@ pub struct SolveJob {
     pub mesh: MeshOptions,
     pub solve: SolveConfig,
     pub out: PathBuf,
+    /// `--intersector`.
+    pub intersector: IntersectorKind,
     pub camera: CameraSpec,
     pub render: RenderOptions,
 }
@@ -169,8 +171,9 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
     ));
 
     let t = Instant::now();
-    let isect = EmbreeScene::build(&m, |_| true)?;
+    let (isect, chosen) = select::select(&m, job.intersector)?;
     timings.build = t.elapsed().as_secs_f64();
+    log(&format!("intersector {}: {}", isect.name(), chosen.reason));
 
     let t = Instant::now();
     let sol = solve::solve(
@@ -233,6 +236,7 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         lights: report::lights(&scene, &m),
         method: job.solve.method.name(),
         intersector: isect.name(),
+        intersector_reason: chosen.reason.clone(),
         seed: job.solve.seed,
         threads: rayon::current_num_threads(),
         tolerance: job.solve.tolerance,
@@ -292,6 +296,9 @@ pub struct RayBench {
     pub triangles: usize,
     pub patches: usize,
     pub threads: usize,
+    /// The intersector measured and solved with (`--intersector`), and why.
+    pub intersector: &'static str,
+    pub intersector_reason: String,
     /// Closest-hit queries per second on random rays (origins uniform in the bounds,
     /// directions uniform on the sphere), all threads.
     pub raw_rays_per_second: f64,
@@ -342,17 +349,19 @@ pub fn raw_throughput<I: Intersector>(
     (chunks * 4096, t.elapsed().as_secs_f64())
 }
 
-/// `radiosity bench rays`: raw Embree throughput and the solver's, side by side in one run.
+/// `radiosity bench rays`: the intersector's raw throughput and the solver's, side by side in
+/// one run.
 pub fn bench_rays(
     source: &SceneSource,
     load: &LoadOptions,
     mesh_opts: &MeshOptions,
     cfg: &SolveConfig,
+    kind: IntersectorKind,
     raw_rays: u64,
 ) -> Result<RayBench, Error> {
     let scene = load_scene(source, load)?;
     let m = mesh::build(&scene, mesh_opts);
-    let isect = EmbreeScene::build(&m, |_| true)?;
+    let (isect, chosen) = select::select(&m, kind)?;
     let (lo, hi) = scene.bounds();
     // Warm up (page in the BVH, spin up the threads), then measure the raw rate before and
     // after the solve, so a drift of the machine's speed shows and averages out.
@@ -369,9 +378,11 @@ pub fn bench_rays(
     let solver = sol.stats.rays as f64 / sol.stats.seconds.max(1e-9);
     Ok(RayBench {
         scene: scene.name.clone(),
-        triangles: isect.triangle_count(),
+        triangles: m.triangles().count(),
         patches: m.patches.len(),
         threads: rayon::current_num_threads(),
+        intersector: isect.name(),
+        intersector_reason: chosen.reason,
         raw_rays_per_second: raw,
         raw_rays: n_raw,
         raw_before_after: [n1 as f64 / s1.max(1e-9), n2 as f64 / s2.max(1e-9)],
