@@ -4,7 +4,7 @@
 
 use crate::generate::{self, BuildingOptions};
 use crate::intersect::bench::{self, BenchRow};
-use crate::intersect::crosscheck::{self, CrossReport};
+use crate::intersect::crosscheck::{self, CrossReport, RaySource};
 use crate::mesh::{self, MeshOptions};
 use crate::pipeline::{load_scene, SceneSource};
 use crate::scene::{self, LoadOptions, Scene};
@@ -104,40 +104,55 @@ fn short(n: usize) -> String {
     }
 }
 
-/// `radiosity bench intersect`: each scene of `scenes` (meshed with `mesh_opts`), then a
-/// generated building of each size in `generated` (at the generator's patch size), through
-/// every applicable intersector. `log` hears each row as it is measured.
+/// Everything `radiosity bench intersect` does.
+#[derive(Clone, Debug)]
+pub struct BenchJob {
+    /// Scenes, meshed with `mesh`.
+    pub scenes: Vec<SceneSource>,
+    /// Generated buildings of about these many patches (at the generator's patch size).
+    pub generated: Vec<usize>,
+    pub load: LoadOptions,
+    pub mesh: MeshOptions,
+    /// Rays per intersector and scene.
+    pub rays: u64,
+    pub seed: u64,
+    /// Rays of this kind only (both kinds if `None`).
+    pub rays_from: Option<RaySource>,
+}
+
+/// `radiosity bench intersect`: each scene, then each generated building, through every
+/// applicable intersector. `log` hears each row as it is measured.
 pub fn bench_intersect(
-    scenes: &[SceneSource],
-    generated: &[usize],
-    load: &LoadOptions,
-    mesh_opts: &MeshOptions,
-    rays: u64,
-    seed: u64,
+    job: &BenchJob,
     mut log: impl FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, Error> {
-    check_patch_size(mesh_opts)?;
-    if rays == 0 {
+    check_patch_size(&job.mesh)?;
+    if job.rays == 0 {
         return Err(Error::Invalid("--rays must be at least 1".into()));
     }
-    if let Some(&n) = generated.iter().find(|&&n| !(1..=10_000_000).contains(&n)) {
+    if let Some(&n) = job
+        .generated
+        .iter()
+        .find(|&&n| !(1..=10_000_000).contains(&n))
+    {
         return Err(Error::Invalid(format!(
             "--generated sizes must be between 1 and 10000000 patches, got {n}"
         )));
     }
+    let (rays, seed, from) = (job.rays, job.seed, job.rays_from);
     let mut rows = Vec::new();
-    for source in scenes {
-        let scene = load_scene(source, load)?;
-        let m = mesh::build(&scene, mesh_opts);
-        let row = bench::bench_mesh(&scene.name, &m, rays, seed)?;
+    for source in &job.scenes {
+        let scene = load_scene(source, &job.load)?;
+        let m = mesh::build(&scene, &job.mesh);
+        let row = bench::bench_mesh(&scene.name, &m, rays, seed, from)?;
         log(&row);
         rows.push(row);
     }
-    for &n in generated {
+    for &n in &job.generated {
         let scene = generated_building(n)?;
         let m = mesh::build(&scene, &MeshOptions::default());
         drop(scene);
-        let row = bench::bench_mesh(&format!("building-{}", short(n)), &m, rays, seed)?;
+        let row = bench::bench_mesh(&format!("building-{}", short(n)), &m, rays, seed, from)?;
         log(&row);
         rows.push(row);
     }

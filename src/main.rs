@@ -121,6 +121,10 @@ enum BenchCommand {
         rays: u64,
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// Which rays: from patch surfaces as the solver casts them, uniform (origin in the
+        /// bounds, direction on the sphere), or half of each.
+        #[arg(long, value_enum, default_value_t = RaysArg::Both)]
+        source: RaysArg,
         /// Also write the table as CSV to this file.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -224,6 +228,14 @@ impl From<IntersectorArg> for IntersectorKind {
             IntersectorArg::Hybrid => IntersectorKind::Hybrid,
         }
     }
+}
+
+/// `bench intersect --source`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum RaysArg {
+    Both,
+    Surface,
+    Uniform,
 }
 
 /// A list of patch counts.
@@ -510,23 +522,31 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
             generated,
             rays,
             seed,
+            source: rays_from,
             out,
         }) => {
+            use radiosity::intersect::crosscheck::RaySource;
+            let rays_from = match rays_from {
+                RaysArg::Both => None,
+                RaysArg::Surface => Some(RaySource::Surface),
+                RaysArg::Uniform => Some(RaySource::Uniform),
+            };
             let sources: Vec<SceneSource> = scenes.into_iter().map(SceneSource::File).collect();
-            let rows = intersect_jobs::bench_intersect(
-                &sources,
-                &generated.0,
-                &scene_args.load(),
-                &scene_args.mesh(),
+            let job = intersect_jobs::BenchJob {
+                scenes: sources,
+                generated: generated.0,
+                load: scene_args.load(),
+                mesh: scene_args.mesh(),
                 rays,
                 seed,
-                |r| {
-                    eprintln!(
-                        "{}: {} patches, embree {:.2}, hybrid {:.2} Mrays/s",
-                        r.scene, r.shape.patches, r.embree.mrays, r.hybrid.mrays
-                    )
-                },
-            )?;
+                rays_from,
+            };
+            let rows = intersect_jobs::bench_intersect(&job, |r| {
+                eprintln!(
+                    "{}: {} patches, embree {:.2}, hybrid {:.2} Mrays/s",
+                    r.scene, r.shape.patches, r.embree.mrays, r.hybrid.mrays
+                )
+            })?;
             print!("{}", radiosity::intersect::bench::markdown(&rows));
             if let Some(path) = out {
                 let text = radiosity::intersect::bench::csv(&rows);
