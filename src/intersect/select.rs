@@ -149,7 +149,7 @@ pub struct Selection {
 /// The `auto` rule, from `radiosity bench intersect` on this machine (README, "Intersectors"):
 /// **Embree over the whole scene, always.** Over the scenes of `scenes/` (232 to 5,267 patches)
 /// and generated buildings of 1 k to 1 M patches, on the solver's rays, the hybrid ran at 0.3 to
-/// 0.9× Embree's rate and the merge alone (hallway, the one axial-only scene) at 0.85×; no
+/// 0.95× Embree's rate and the merge alone (hallway, the one axial-only scene) at 0.5–0.9×; no
 /// scene or size had either ahead by more than the run-to-run noise. The rule the earlier rough
 /// measurements suggested ("merge/hybrid on axial scenes of ≤ 500 k patches with few planes
 /// per axis") came from rooms without furniture, whose rays cross a handful of planes; the
