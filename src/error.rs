@@ -23,13 +23,16 @@ pub enum Error {
     /// A bad setting (flag value, combination).
     #[error("{0}")]
     Invalid(String),
+    /// A check ran and its bar failed (`radiosity crosscheck`): exit code 1.
+    #[error("{0}")]
+    Failed(String),
 }
 
 impl Error {
     /// 2 for what the user can fix (input, flags, output folder), 1 for internal failures.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Embree(_) => 1,
+            Error::Embree(_) | Error::Failed(_) => 1,
             _ => 2,
         }
     }

@@ -14,6 +14,7 @@ pub mod error;
 pub mod export;
 pub mod generate;
 pub mod intersect;
+pub mod intersect_jobs;
 pub mod mesh;
 pub mod pipeline;
 pub mod render;

@@ -3,6 +3,8 @@
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
+use radiosity::intersect::select::IntersectorKind;
+use radiosity::intersect_jobs::{self, CrossJob};
 use radiosity::mesh::MeshOptions;
 use radiosity::pipeline::{self, CameraSpec, SceneSource, SolveJob};
 use radiosity::render::RenderOptions;
@@ -40,6 +42,9 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Cast the same rays through every intersector the scene supports and compare the hit
+    /// patches against the reference (exit code 1 if the bar fails).
+    Crosscheck(CrosscheckArgs),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -68,8 +73,62 @@ enum GenerateCommand {
     },
 }
 
+#[derive(Args)]
+struct CrosscheckArgs {
+    /// OBJ file (with its MTL beside it); the built-in Cornell box if left out.
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    scene_args: SceneArgs,
+    /// Rays to cast (half from patch surfaces as the solver casts them, half uniform).
+    #[arg(long)]
+    rays: u64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Edge distance, relative to the scene's diagonal, within which a disagreement counts as
+    /// crossing a patch edge.
+    #[arg(long, default_value_t = 1e-5, allow_negative_numbers = true)]
+    eps: f32,
+    /// The scene is open: rays escaping it do not fail the bar (default: judged by the
+    /// reference's escapes).
+    #[arg(long, conflicts_with = "closed")]
+    open: bool,
+    /// The scene is closed: any escape fails the bar.
+    #[arg(long)]
+    closed: bool,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Also write the report to this file (JSON if it ends in .json, else text).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// Mrays/s of Embree (whole scene), the plane merge, the hybrid and brute force, side by
+    /// side on each scene and on generated buildings.
+    Intersect {
+        /// OBJ files (with their MTL beside them).
+        scenes: Vec<PathBuf>,
+        #[command(flatten)]
+        scene_args: SceneArgs,
+        /// Generated buildings of about these many patches (1k = 1000, 1M = 1000000; "none"
+        /// for none). 1M takes minutes and a few GB.
+        #[arg(long, value_parser = parse_sizes, default_value = "1k,10k,100k")]
+        generated: Sizes,
+        /// Rays per intersector and scene (brute force casts fewer).
+        #[arg(long, default_value_t = 1_000_000)]
+        rays: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Which rays: from patch surfaces as the solver casts them, uniform (origin in the
+        /// bounds, direction on the sphere), or half of each.
+        #[arg(long, value_enum, default_value_t = RaysArg::Both)]
+        source: RaysArg,
+        /// Also write the table as CSV to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Raw Embree closest-hit throughput on random rays against the solver's rays per second,
     /// measured in one run.
     Rays {
@@ -171,6 +230,65 @@ struct SolverArgs {
     /// measured costs say so (the switch shot a summary.json recorded: an exact replay).
     #[arg(long, value_name = "SHOT")]
     switch_at: Option<u64>,
+    /// Ray intersector: auto picks per scene (the rule is in `radiosity info`); merge needs a
+    /// scene whose patches are all axis-aligned.
+    #[arg(long, value_enum, default_value_t = IntersectorArg::Auto)]
+    intersector: IntersectorArg,
+}
+
+/// `--intersector`: see `radiosity::intersect::select::IntersectorKind`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum IntersectorArg {
+    Auto,
+    Embree,
+    Merge,
+    Hybrid,
+}
+
+impl From<IntersectorArg> for IntersectorKind {
+    fn from(a: IntersectorArg) -> IntersectorKind {
+        match a {
+            IntersectorArg::Auto => IntersectorKind::Auto,
+            IntersectorArg::Embree => IntersectorKind::Embree,
+            IntersectorArg::Merge => IntersectorKind::Merge,
+            IntersectorArg::Hybrid => IntersectorKind::Hybrid,
+        }
+    }
+}
+
+/// `bench intersect --source`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum RaysArg {
+    Both,
+    Surface,
+    Uniform,
+}
+
+/// A list of patch counts.
+#[derive(Clone)]
+struct Sizes(Vec<usize>);
+
+fn parse_sizes(s: &str) -> Result<Sizes, String> {
+    if s.trim().is_empty() || s.trim() == "none" {
+        return Ok(Sizes(Vec::new()));
+    }
+    s.split(',')
+        .map(|p| {
+            let p = p.trim();
+            let (num, mul) = match p.chars().last() {
+                Some('k' | 'K') => (&p[..p.len() - 1], 1_000.0),
+                Some('M' | 'm') => (&p[..p.len() - 1], 1_000_000.0),
+                _ => (p, 1.0),
+            };
+            match num.parse::<f64>() {
+                Ok(v) if v > 0.0 && (v * mul) <= 1e7 => Ok((v * mul).round() as usize),
+                _ => Err(format!(
+                    "'{p}' is not a patch count between 1 and 10M (like 1000, 10k or 1M)"
+                )),
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Sizes)
 }
 
 /// `--method`: see `radiosity::solve::MethodKind`.
@@ -342,6 +460,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 solve: a.solve_args.config()?,
                 out: a.out.clone(),
                 reference: a.reference.clone(),
+                intersector: a.solve_args.intersector.into(),
                 camera: CameraSpec {
                     eye: a.eye,
                     target: a.target,
@@ -459,6 +578,45 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
             }
             Ok(())
         }
+        Command::Crosscheck(a) => crosscheck(a),
+        Command::Bench(BenchCommand::Intersect {
+            scenes,
+            scene_args,
+            generated,
+            rays,
+            seed,
+            source: rays_from,
+            out,
+        }) => {
+            use radiosity::intersect::crosscheck::RaySource;
+            let rays_from = match rays_from {
+                RaysArg::Both => None,
+                RaysArg::Surface => Some(RaySource::Surface),
+                RaysArg::Uniform => Some(RaySource::Uniform),
+            };
+            let sources: Vec<SceneSource> = scenes.into_iter().map(SceneSource::File).collect();
+            let job = intersect_jobs::BenchJob {
+                scenes: sources,
+                generated: generated.0,
+                load: scene_args.load(),
+                mesh: scene_args.mesh(),
+                rays,
+                seed,
+                rays_from,
+            };
+            let rows = intersect_jobs::bench_intersect(&job, |r| {
+                eprintln!(
+                    "{}: {} patches, embree {:.2}, hybrid {:.2} Mrays/s",
+                    r.scene, r.shape.patches, r.embree.mrays, r.hybrid.mrays
+                )
+            })?;
+            print!("{}", radiosity::intersect::bench::markdown(&rows));
+            if let Some(path) = out {
+                let text = radiosity::intersect::bench::csv(&rows);
+                radiosity::export::write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
+            }
+            Ok(())
+        }
         Command::Bench(BenchCommand::Rays {
             scene,
             scene_args,
@@ -477,15 +635,17 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 &scene_args.load(),
                 &scene_args.mesh(),
                 &solve_args.config()?,
+                solve_args.intersector.into(),
                 rays,
                 min_seconds,
             )?;
             println!(
-                "{}: {} triangles, {} patches, {} threads\n  raw Embree closest hit: {:.2} Mrays/s ({} rays; {:.2} to {:.2} over the run)\n  solver:                 {:.2} Mrays/s ({} rays in {} solves)\n  solver / raw:           {:.0} %",
+                "{}: {} triangles, {} patches, {} threads\n  raw {} closest hit: {:.2} Mrays/s ({} rays; {:.2} to {:.2} over the run)\n  solver:                 {:.2} Mrays/s ({} rays in {} solves)\n  solver / raw:           {:.0} %",
                 b.scene,
                 b.triangles,
                 b.patches,
                 b.threads,
+                b.intersector,
                 b.raw_rays_per_second / 1e6,
                 b.raw_rays,
                 b.raw_min_max[0] / 1e6,
@@ -503,6 +663,49 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
             }
             Ok(())
         }
+    }
+}
+
+fn crosscheck(a: CrosscheckArgs) -> Result<(), radiosity::Error> {
+    let job = CrossJob {
+        source: source(a.scene),
+        load: a.scene_args.load(),
+        mesh: a.scene_args.mesh(),
+        rays: a.rays,
+        seed: a.seed,
+        eps: a.eps,
+        closed: match (a.open, a.closed) {
+            (true, _) => Some(false),
+            (_, true) => Some(true),
+            _ => None,
+        },
+    };
+    let c = intersect_jobs::crosscheck(&job)?;
+    let json = serde_json::to_string_pretty(&c).unwrap_or_default();
+    if a.json {
+        println!("{json}");
+    } else {
+        print!("{c}");
+    }
+    if let Some(path) = a.out {
+        let text = if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            json + "\n"
+        } else {
+            c.to_string()
+        };
+        radiosity::export::write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
+    }
+    if c.report.passed {
+        Ok(())
+    } else {
+        Err(radiosity::Error::Failed(format!(
+            "{}: the cross-check bar failed: {}",
+            c.scene,
+            c.report.failures.join("; ")
+        )))
     }
 }
 

@@ -2,7 +2,7 @@
 //! write the patch table, the image and the JSON summary. The binary only fills a [`SolveJob`].
 
 use crate::export::{self, patches, write_atomic};
-use crate::intersect::embree::EmbreeScene;
+use crate::intersect::select::{self, IntersectorKind};
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::{self, Mesh, MeshOptions};
 use crate::render::{self, Camera, RenderOptions};
@@ -61,6 +61,8 @@ pub struct SolveJob {
     pub mesh: MeshOptions,
     pub solve: SolveConfig,
     pub out: PathBuf,
+    /// `--intersector`.
+    pub intersector: IntersectorKind,
     pub camera: CameraSpec,
     pub render: RenderOptions,
     /// A reference patch table (`--reference`): the trace then records the error against it.
@@ -213,12 +215,16 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
 
     // Only the methods that cast rays need an intersector (a scene builds what it needs).
     let t = Instant::now();
-    let isect = if job.solve.method.casts_rays() {
-        Some(EmbreeScene::build(&m, |_| true)?)
+    let (isect, chosen) = if job.solve.method.casts_rays() {
+        let (isect, chosen) = select::select(&m, job.intersector)?;
+        (Some(isect), Some(chosen))
     } else {
-        None
+        (None, None)
     };
     timings.build = t.elapsed().as_secs_f64();
+    if let (Some(isect), Some(chosen)) = (&isect, &chosen) {
+        log(&format!("intersector {}: {}", isect.name(), chosen.reason));
+    }
 
     let mut cfg = job.solve.clone();
     if let Some(path) = &job.reference {
@@ -288,6 +294,10 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         lights: report::lights(&scene, &m),
         method: job.solve.method.name(),
         intersector: isect.as_ref().map_or("none (no rays cast)", |i| i.name()),
+        intersector_reason: chosen.as_ref().map_or_else(
+            || "the method casts no rays".to_string(),
+            |c| c.reason.clone(),
+        ),
         seed: job.solve.seed,
         threads: rayon::current_num_threads(),
         tolerance: job.solve.tolerance,
@@ -357,6 +367,9 @@ pub struct RayBench {
     pub triangles: usize,
     pub patches: usize,
     pub threads: usize,
+    /// The intersector measured and solved with (`--intersector`), and why.
+    pub intersector: &'static str,
+    pub intersector_reason: String,
     /// Closest-hit queries per second on random rays (origins uniform in the bounds,
     /// directions uniform on the sphere), all threads.
     pub raw_rays_per_second: f64,
@@ -410,12 +423,14 @@ pub fn raw_throughput<I: Intersector>(
     (chunks * 4096, t.elapsed().as_secs_f64())
 }
 
-/// `radiosity bench rays`: raw Embree throughput and the solver's, side by side in one run.
+/// `radiosity bench rays`: the intersector's raw throughput and the solver's, side by side in
+/// one run.
 pub fn bench_rays(
     source: &SceneSource,
     load: &LoadOptions,
     mesh_opts: &MeshOptions,
     cfg: &SolveConfig,
+    kind: IntersectorKind,
     raw_rays: u64,
     min_seconds: f64,
 ) -> Result<RayBench, Error> {
@@ -426,7 +441,7 @@ pub fn bench_rays(
     };
     let scene = load_scene(source, load)?;
     let m = mesh::build(&scene, mesh_opts);
-    let isect = EmbreeScene::build(&m, |_| true)?;
+    let (isect, chosen) = select::select(&m, kind)?;
     let (lo, hi) = scene.bounds();
     // Warm up (page in the BVH, spin up the threads). Then alternate raw measurements and
     // solves (seeds seed, seed + 1, …) until the solves add up to `min_seconds`, ending with
@@ -467,9 +482,11 @@ pub fn bench_rays(
     };
     Ok(RayBench {
         scene: scene.name.clone(),
-        triangles: isect.triangle_count(),
+        triangles: m.triangles().count(),
         patches: m.patches.len(),
         threads: rayon::current_num_threads(),
+        intersector: isect.name(),
+        intersector_reason: chosen.reason,
         raw_rays_per_second: raw,
         raw_rays: n_raw,
         raw_min_max: spread(&raw_rates),

@@ -1,5 +1,6 @@
 //! What a run reports: the JSON summary of a solve and the description of a scene (`info`).
 
+use crate::intersect::select;
 use crate::mesh::{Mesh, PatchClass};
 use crate::scene::Scene;
 use crate::solve::error::ErrorMetrics;
@@ -41,6 +42,9 @@ pub struct SceneInfo {
     pub bounds_max: [f32; 3],
     pub materials: Vec<MaterialInfo>,
     pub lights: Vec<LightInfo>,
+    /// What `--intersector auto` picks for this scene, and why.
+    pub intersector: &'static str,
+    pub intersector_reason: String,
     pub warnings: Vec<String>,
 }
 
@@ -84,6 +88,7 @@ pub fn lights(scene: &Scene, mesh: &Mesh) -> Vec<LightInfo> {
 pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
     let (fc, fa) = axial_fractions(mesh);
     let (lo, hi) = scene.bounds();
+    let (auto, why) = select::auto_rule(&select::SceneShape::of(mesh));
     let mut count = vec![0usize; scene.materials.len()];
     for p in &scene.polygons {
         count[p.material as usize] += 1;
@@ -111,6 +116,8 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
             })
             .collect(),
         lights: lights(scene, mesh),
+        intersector: auto.name(),
+        intersector_reason: why,
         warnings: scene.warnings.clone(),
     }
 }
@@ -160,6 +167,11 @@ impl std::fmt::Display for SceneInfo {
                 l.power[2]
             )?;
         }
+        writeln!(
+            f,
+            "intersector    {} (auto: {})",
+            self.intersector, self.intersector_reason
+        )?;
         for w in &self.warnings {
             writeln!(f, "warning: {w}")?;
         }
@@ -213,6 +225,8 @@ pub struct Summary {
     pub lights: Vec<LightInfo>,
     pub method: &'static str,
     pub intersector: &'static str,
+    /// Why that intersector (the `auto` rule's reason, or "forced by --intersector").
+    pub intersector_reason: String,
     pub seed: u64,
     pub threads: usize,
     pub tolerance: f64,

@@ -339,6 +339,59 @@ fn gathering_refuses_a_matrix_over_the_cap() {
     );
 }
 
+fn scene_path(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+#[test]
+fn crosscheck_passes_on_a_small_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("cross.json");
+    let (code, out, err) = run(&[
+        "crosscheck",
+        &scene_path("blocks.obj"),
+        "--rays",
+        "20000",
+        "--out",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("bar passed"), "{out}");
+    assert!(out.contains("embree vs brute"), "{out}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["passed"], true);
+    assert_eq!(v["closed"], true);
+    assert_eq!(v["rays"], 20000);
+}
+
+#[test]
+fn crosscheck_bad_flags() {
+    assert_user_error(&["crosscheck", "--rays", "0"], &["--rays"]);
+    assert_user_error(&["crosscheck", "--rays", "10", "--eps", "-1"], &["--eps"]);
+}
+
+#[test]
+fn intersector_merge_on_a_skew_scene_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    assert_user_error(
+        &[
+            "solve",
+            &scene_path("blocks.obj"),
+            "--intersector",
+            "merge",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["--intersector merge", "skew"],
+    );
+}
+
 #[test]
 fn switch_at_needs_the_hybrid() {
     assert_user_error(
@@ -346,4 +399,54 @@ fn switch_at_needs_the_hybrid() {
         &["--switch-at", "adaptive-hybrid"],
     );
     assert_user_error(&["solve", "--hemicube-n", "1"], &["--hemicube-n"]);
+}
+
+#[test]
+fn solve_reports_the_intersector_and_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let (code, stdout, err) = run(&[
+        "solve",
+        &scene_path("blocks.obj"),
+        "--intersector",
+        "hybrid",
+        "--tolerance",
+        "0.2",
+        "--json",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(v["intersector"], "hybrid");
+    assert_eq!(v["intersector_reason"], "forced by --intersector");
+    let (code, stdout, _) = run(&["info", &scene_path("hallway.obj")]);
+    assert_eq!(code, 0);
+    assert!(stdout.contains("intersector    embree (auto:"), "{stdout}");
+}
+
+#[test]
+fn bench_intersect_writes_a_table_and_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("bench.csv");
+    let (code, out, err) = run(&[
+        "bench",
+        "intersect",
+        &scene_path("blocks.obj"),
+        "--generated",
+        "none",
+        "--rays",
+        "4000",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.starts_with("| scene | patches |"), "{out}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(text.lines().count(), 2, "{text}");
+    assert!(text.starts_with("scene,patches,"), "{text}");
+    assert_user_error(
+        &["bench", "intersect", "--generated", "0"],
+        &["--generated"],
+    );
 }

@@ -3,13 +3,17 @@
 //! [`Intersector`] is the seam between the solver and the geometry. The solver is generic over
 //! it (STYLE.md: match the configured kind once, then run generic code — no `dyn` per ray).
 //! [`embree::EmbreeScene`] casts through Intel Embree 4; [`brute::BruteForce`] tests every patch
-//! and serves as the test oracle.
+//! and serves as the test oracle; [`plane_merge::PlaneMerge`] is the paper's three-way merge
+//! over axis-aligned planes (Sec. 2) and [`hybrid::Hybrid`] adds Embree for the skew patches.
+//! [`select::AnyIntersector`] is the enum a solve is built with (`--intersector`).
 
+pub mod bench;
 pub mod brute;
 pub mod crosscheck;
 pub mod embree;
 pub mod hybrid;
 pub mod plane_merge;
+pub mod select;
 
 use glam::Vec3;
 

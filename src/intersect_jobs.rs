@@ -1,0 +1,160 @@
+//! What `radiosity crosscheck` and `radiosity bench intersect` run: load or generate the
+//! scenes, mesh them, and hand them to [`crate::intersect::crosscheck`] and
+//! [`crate::intersect::bench`]. The binary only fills the jobs and prints.
+
+use crate::generate::{self, BuildingOptions};
+use crate::intersect::bench::{self, BenchRow};
+use crate::intersect::crosscheck::{self, CrossReport, RaySource};
+use crate::mesh::{self, MeshOptions};
+use crate::pipeline::{load_scene, SceneSource};
+use crate::scene::{self, LoadOptions, Scene};
+use crate::Error;
+
+/// Everything `radiosity crosscheck` does.
+#[derive(Clone, Debug)]
+pub struct CrossJob {
+    pub source: SceneSource,
+    pub load: LoadOptions,
+    pub mesh: MeshOptions,
+    pub rays: u64,
+    pub seed: u64,
+    /// Edge distance for the "edge" class, relative to the scene's diagonal.
+    pub eps: f32,
+    /// `Some` declares the scene closed or open; `None` judges by the reference's escapes.
+    pub closed: Option<bool>,
+}
+
+/// `radiosity crosscheck`'s result: the scene and the report.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CrossCheck {
+    pub scene: String,
+    pub patch_size: f32,
+    #[serde(flatten)]
+    pub report: CrossReport,
+}
+
+impl std::fmt::Display for CrossCheck {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        writeln!(f, "{} at patch size {} m", self.scene, self.patch_size)?;
+        write!(f, "{}", self.report)
+    }
+}
+
+fn check_patch_size(m: &MeshOptions) -> Result<(), Error> {
+    match m.patch_size {
+        Some(ps) if !(ps > 0.0 && ps.is_finite()) => Err(Error::Invalid(format!(
+            "--patch-size must be a positive length in metres, got {ps}"
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Runs the cross-check; the bar's verdict is in the report (`passed`), not an error.
+pub fn crosscheck(job: &CrossJob) -> Result<CrossCheck, Error> {
+    check_patch_size(&job.mesh)?;
+    if job.rays == 0 {
+        return Err(Error::Invalid("--rays must be at least 1".into()));
+    }
+    if !(job.eps > 0.0 && job.eps < 1.0) {
+        return Err(Error::Invalid(format!(
+            "--eps must be in (0, 1), got {}",
+            job.eps
+        )));
+    }
+    let scene = load_scene(&job.source, &job.load)?;
+    let m = mesh::build(&scene, &job.mesh);
+    if m.patches.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: no patches to cast at",
+            scene.name
+        )));
+    }
+    let mut report = crosscheck::crosscheck(&m, job.rays, job.seed, job.eps)?;
+    if job.closed.is_some() {
+        report.apply_bar(job.closed);
+    }
+    Ok(CrossCheck {
+        scene: scene.name.clone(),
+        patch_size: m.patch_size,
+        report,
+    })
+}
+
+/// A generated building of about `patches` patches (seed 1), made in memory.
+pub fn generated_building(patches: usize) -> Result<Scene, Error> {
+    let opts = BuildingOptions::for_patches(patches, 1);
+    let (mut obj, mut mtl) = (Vec::new(), Vec::new());
+    generate::write_building(&mut obj, &mut mtl, "building.mtl", &opts)
+        .map_err(|e| Error::Invalid(format!("generating a building: {e}")))?;
+    let text = |b: Vec<u8>| String::from_utf8(b).unwrap_or_default();
+    Ok(scene::load_obj_from_strs(
+        &format!("building-{}", short(patches)),
+        &text(obj),
+        &text(mtl),
+        &LoadOptions::default(),
+    )?)
+}
+
+/// 1000 → "1k", 1000000 → "1M".
+fn short(n: usize) -> String {
+    match n {
+        n if n >= 1_000_000 && n % 1_000_000 == 0 => format!("{}M", n / 1_000_000),
+        n if n >= 1000 && n % 1000 == 0 => format!("{}k", n / 1000),
+        n => n.to_string(),
+    }
+}
+
+/// Everything `radiosity bench intersect` does.
+#[derive(Clone, Debug)]
+pub struct BenchJob {
+    /// Scenes, meshed with `mesh`.
+    pub scenes: Vec<SceneSource>,
+    /// Generated buildings of about these many patches (at the generator's patch size).
+    pub generated: Vec<usize>,
+    pub load: LoadOptions,
+    pub mesh: MeshOptions,
+    /// Rays per intersector and scene.
+    pub rays: u64,
+    pub seed: u64,
+    /// Rays of this kind only (both kinds if `None`).
+    pub rays_from: Option<RaySource>,
+}
+
+/// `radiosity bench intersect`: each scene, then each generated building, through every
+/// applicable intersector. `log` hears each row as it is measured.
+pub fn bench_intersect(
+    job: &BenchJob,
+    mut log: impl FnMut(&BenchRow),
+) -> Result<Vec<BenchRow>, Error> {
+    check_patch_size(&job.mesh)?;
+    if job.rays == 0 {
+        return Err(Error::Invalid("--rays must be at least 1".into()));
+    }
+    if let Some(&n) = job
+        .generated
+        .iter()
+        .find(|&&n| !(1..=10_000_000).contains(&n))
+    {
+        return Err(Error::Invalid(format!(
+            "--generated sizes must be between 1 and 10000000 patches, got {n}"
+        )));
+    }
+    let (rays, seed, from) = (job.rays, job.seed, job.rays_from);
+    let mut rows = Vec::new();
+    for source in &job.scenes {
+        let scene = load_scene(source, &job.load)?;
+        let m = mesh::build(&scene, &job.mesh);
+        let row = bench::bench_mesh(&scene.name, &m, rays, seed, from)?;
+        log(&row);
+        rows.push(row);
+    }
+    for &n in &job.generated {
+        let scene = generated_building(n)?;
+        let m = mesh::build(&scene, &MeshOptions::default());
+        drop(scene);
+        let row = bench::bench_mesh(&format!("building-{}", short(n)), &m, rays, seed, from)?;
+        log(&row);
+        rows.push(row);
+    }
+    Ok(rows)
+}
