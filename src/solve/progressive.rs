@@ -384,7 +384,12 @@ pub fn shoot<I: Intersector>(
             .map_or(0, |p| p.hits.iter().map(Vec::len).sum::<usize>())
             as u64;
         let samples = st.rays + st.cells + in_flight;
-        let reason = if max_b < cfg.stop_fraction * mean_b {
+        let flying = pending
+            .as_ref()
+            .map_or(0.0, |p| p.wave.iter().map(|s| scalar(&s.phi)).sum::<f64>());
+        // Sec. 3's criterion, on the light unshot radiosity will still add (see
+        // `State::amplification`).
+        let reason = if max_b * st.amplification(flying) < cfg.stop_fraction * mean_b {
             // The max-ΔB heap holds only patches above the threshold; whether any energy at
             // all is left, the flux heap says.
             if st.has_unshot() {
