@@ -365,6 +365,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                     floors,
                     rooms_per_floor: rooms,
                     seed,
+                    ..Default::default()
                 },
             };
             let st = generate_building(&out, &opts)?;

@@ -61,6 +61,10 @@ pub struct BuildingOptions {
     pub rooms_per_floor: u32,
     /// Seed of every random choice (room widths, doors, furniture): same seed, same bytes.
     pub seed: u64,
+    /// Room widths in per cent of the widths drawn from the seed (100: as drawn; no room
+    /// narrower than 2.1 m). [`BuildingOptions::for_patches`] stretches or shrinks small
+    /// buildings with it, where a whole room more or less is too coarse a step.
+    pub width_percent: u32,
 }
 
 /// What was written.
@@ -82,6 +86,7 @@ impl Default for BuildingOptions {
             floors: 3,
             rooms_per_floor: 8,
             seed: 1,
+            width_percent: 100,
         }
     }
 }
@@ -89,45 +94,90 @@ impl Default for BuildingOptions {
 impl BuildingOptions {
     /// A building of about `target` patches at [`BUILDING_PATCH_SIZE`]: floors grow as the
     /// square root of the target, rooms per floor are then found by counting (secant steps on
-    /// dry runs, which write nothing). From about 2,000 patches up the result is within a few
-    /// per cent; below, a building grows by whole rooms of about 900 patches (one room: about
-    /// 1,000), so the nearest is returned.
+    /// dry runs, which write nothing). A room is about 1,000 patches, so below a few thousand
+    /// whole rooms are too coarse a step (one room: ~1,100, two: ~2,200): when the nearest
+    /// count misses by more than [`FIT_TOLERANCE`], the room widths are stretched or shrunk
+    /// ([`BuildingOptions::width_percent`], bisection on dry runs) for that number of rooms
+    /// and the one below. Every target from 1,000 to 2,000,000 lands within a few per cent.
     pub fn for_patches(target: usize, seed: u64) -> BuildingOptions {
         let floors = ((target as f64 / 2500.0).sqrt().round() as u32).clamp(1, 40);
-        let opts = |rooms: u32| BuildingOptions {
+        let opts = |rooms: u32, width_percent: u32| BuildingOptions {
             floors,
             rooms_per_floor: rooms.max(1),
             seed,
+            width_percent,
         };
-        let count = |rooms: u32| -> f64 {
-            build(None, None, "", &opts(rooms))
-                .map_or(f64::INFINITY, |s| s.estimated_patches as f64)
+        let count = |o: &BuildingOptions| -> f64 {
+            build(None, None, "", o).map_or(f64::INFINITY, |s| s.estimated_patches as f64)
         };
         let target = target as f64;
-        let (mut r0, mut c0) = (1u32, count(1));
-        let mut best = (r0, (c0 - target).abs());
-        if c0 >= target {
-            return opts(1);
+        let rooms = nearest_rooms(target, |r| count(&opts(r, 100)));
+        let mut best = (opts(rooms, 100), (count(&opts(rooms, 100)) - target).abs());
+        if best.1 <= FIT_TOLERANCE * target {
+            return best.0;
         }
-        // Patches grow about linearly with rooms: secant steps from a first guess.
-        let mut r1 = ((target / c0).round() as u32).max(2);
-        for _ in 0..6 {
-            let c1 = count(r1);
-            if (c1 - target).abs() < best.1 {
-                best = (r1, (c1 - target).abs());
+        // Patches grow with the room widths (floors, ceilings, walls and corridor all get
+        // longer): bisect on the width for this many rooms, and for one room fewer.
+        for r in [rooms, rooms.saturating_sub(1)] {
+            if r == 0 {
+                continue;
             }
-            if (c1 - target).abs() <= 0.03 * target || c1 == c0 {
+            let (mut lo, mut hi) = (MIN_WIDTH_PERCENT, MAX_WIDTH_PERCENT);
+            while hi - lo > 1 {
+                let mid = (lo + hi) / 2;
+                let o = opts(r, mid);
+                let c = count(&o);
+                if (c - target).abs() < best.1 {
+                    best = (o, (c - target).abs());
+                }
+                if c < target {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            if best.1 <= FIT_TOLERANCE * target {
                 break;
             }
-            let slope = (c1 - c0) / (r1 as f64 - r0 as f64);
-            let next = (r1 as f64 + (target - c1) / slope).round().max(1.0) as u32;
-            if next == r1 {
-                break;
-            }
-            (r0, c0, r1) = (r1, c1, next);
         }
-        opts(best.0)
+        best.0
     }
+}
+
+/// How close to its target [`BuildingOptions::for_patches`] is content to land by rooms
+/// alone before it adjusts the room widths.
+pub const FIT_TOLERANCE: f64 = 0.03;
+/// The room widths [`BuildingOptions::for_patches`] may choose, per cent of the drawn ones:
+/// from narrow rooms to long halls, a range over which one room's count spans more than the
+/// step from one room to two.
+const MIN_WIDTH_PERCENT: u32 = 50;
+const MAX_WIDTH_PERCENT: u32 = 300;
+
+/// The number of rooms per floor whose count (by `count`) is nearest `target`: secant steps,
+/// since patches grow about linearly with rooms.
+fn nearest_rooms(target: f64, count: impl Fn(u32) -> f64) -> u32 {
+    let (mut r0, mut c0) = (1u32, count(1));
+    let mut best = (r0, (c0 - target).abs());
+    if c0 >= target {
+        return 1;
+    }
+    let mut r1 = ((target / c0).round() as u32).max(2);
+    for _ in 0..6 {
+        let c1 = count(r1);
+        if (c1 - target).abs() < best.1 {
+            best = (r1, (c1 - target).abs());
+        }
+        if (c1 - target).abs() <= FIT_TOLERANCE * target || c1 == c0 {
+            break;
+        }
+        let slope = (c1 - c0) / (r1 as f64 - r0 as f64);
+        let next = (r1 as f64 + (target - c1) / slope).round().max(1.0) as u32;
+        if next == r1 {
+            break;
+        }
+        (r0, c0, r1) = (r1, c1, next);
+    }
+    best.0
 }
 
 /// Streams the OBJ into `obj` (with a `mtllib MTL_NAME` line and the patch-size comment) and
@@ -206,10 +256,10 @@ fn build(
     mtl_name: &str,
     opts: &BuildingOptions,
 ) -> io::Result<BuildingStats> {
-    if opts.floors == 0 || opts.rooms_per_floor == 0 {
+    if opts.floors == 0 || opts.rooms_per_floor == 0 || opts.width_percent == 0 {
         return Err(io::Error::new(
             io::ErrorKind::InvalidInput,
-            "a building needs at least one floor and one room per floor",
+            "a building needs at least one floor, one room per floor and a room width above 0 %",
         ));
     }
     if let Some(mtl) = mtl {
@@ -338,6 +388,7 @@ mod tests {
             floors: 2,
             rooms_per_floor: 3,
             seed: 9,
+            ..BuildingOptions::default()
         };
         let (mut obj, mut mtl) = (Vec::new(), Vec::new());
         let written = write_building(&mut obj, &mut mtl, "b.mtl", &opts).unwrap();

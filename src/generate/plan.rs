@@ -84,7 +84,7 @@ pub(super) fn plan(opts: &BuildingOptions, rng: &mut Pcg64Mcg) -> Plan {
     let north_n = units / 2 - has_stair as i64;
     let widths = |n: i64, rng: &mut Pcg64Mcg| -> Vec<i64> {
         (0..n)
-            .map(|_| 2850 + 100 * rng.gen_range(0..17i64))
+            .map(|_| (2850 + 100 * rng.gen_range(0..17i64)) * opts.width_percent as i64 / 100)
             .collect()
     };
     let mut south_w = widths(south_n, rng);
