@@ -12,10 +12,14 @@
 
 pub mod error;
 pub mod export;
+pub mod false_colour;
 pub mod generate;
+pub mod glyphs;
 pub mod intersect;
 pub mod mesh;
+pub mod outputs;
 pub mod pipeline;
+pub mod progress;
 pub mod render;
 pub mod report;
 pub mod sample;
