@@ -72,11 +72,9 @@ impl Progress {
         }
         let pb = ProgressBar::new(STEPS);
         pb.set_style(
-            ProgressStyle::with_template(
-                "solving [{bar:30}] {percent:>3}% of the energy shot, {msg} (eta {eta})",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
+            ProgressStyle::with_template("solving [{bar:20}] {percent:>3}% shot, {msg}, eta {eta}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
         );
         pb.enable_steady_tick(Duration::from_millis(250));
         self.replace(Some(pb));
@@ -90,7 +88,7 @@ impl Progress {
         let f = fraction_shot(p.unshot_flux, self.emitted.get());
         if let Some(pb) = &*self.bar.borrow() {
             pb.set_position((f * STEPS as f64) as u64);
-            pb.set_message(format!("{} shots, {} rays", p.shots, p.rays));
+            pb.set_message(format!("{} shots", p.shots));
         }
     }
 
