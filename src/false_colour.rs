@@ -21,7 +21,7 @@ pub const BACKGROUND: [u8; 3] = [24, 24, 24];
 /// Surfaces whose irradiance is unknown (ρ = 0).
 pub const NO_DATA: [u8; 3] = [128, 128, 128];
 /// The widest range shown, in decades.
-const MAX_DECADES: f64 = 4.0;
+pub const MAX_DECADES: f64 = 4.0;
 
 /// Viridis at nine even stops (sRGB), linearly interpolated between them.
 const VIRIDIS: [[u8; 3]; 9] = [
@@ -70,7 +70,8 @@ impl Scale {
     }
 
     /// From the values seen: the 99th percentile rounded up to a 1–2–5 step, down to the
-    /// 1st percentile rounded down, but no more than [`MAX_DECADES`] below the top.
+    /// 1st percentile rounded down, but no more than [`MAX_DECADES`] below the top and at
+    /// least one decade (so a nearly uniform picture does not exaggerate small differences).
     pub fn fit(values: &mut Vec<f64>) -> Scale {
         values.retain(|v| v.is_finite() && *v > 0.0);
         if values.is_empty() {
@@ -80,8 +81,10 @@ impl Scale {
         let q = |p: f64| values[((values.len() - 1) as f64 * p).round() as usize];
         let hi = nice(q(0.99), true);
         let lo = nice(q(0.01), false).max(hi / 10f64.powf(MAX_DECADES));
-        let lo = if lo < hi { lo } else { hi / 10.0 };
-        Scale { lo, hi }
+        Scale {
+            lo: lo.min(hi / 10.0),
+            hi,
+        }
     }
 
     /// The 1–2–5 values inside the scale, for the legend's ticks (at most about a dozen).
