@@ -430,14 +430,18 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 );
             } else if !a.quiet {
                 println!(
-                    "{}: {} patches, {} shots, {} rays in {:.2} s; energy balance residual {:.1e}; outputs in {}",
+                    "{}: {} patches, {} shots, {} rays in {:.2} s; energy balance residual {:.1e}; outputs in {}{}",
                     summary.scene,
                     summary.patches,
                     summary.shots,
                     summary.rays,
                     summary.seconds.total,
                     summary.energy.relative_residual,
-                    a.out.display()
+                    a.out.display(),
+                    a.save
+                        .as_ref()
+                        .map(|p| format!(", solution saved to {}", p.display()))
+                        .unwrap_or_default()
                 );
             }
             Ok(())
