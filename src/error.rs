@@ -1,6 +1,7 @@
 //! The library's error: one enum over the areas' own errors, each displayed as one line that
 //! names the file and what is wrong. [`Error::exit_code`] says whose fault it is.
 
+use crate::export::solution::SolutionError;
 use crate::export::WriteError;
 use crate::intersect::embree::EmbreeError;
 use crate::scene::SceneError;
@@ -20,6 +21,9 @@ pub enum Error {
     Write(#[from] WriteError),
     #[error(transparent)]
     Embree(#[from] EmbreeError),
+    /// A saved solution that cannot be used (`render`, `export`).
+    #[error(transparent)]
+    Solution(#[from] SolutionError),
     /// A bad setting (flag value, combination).
     #[error("{0}")]
     Invalid(String),

@@ -12,11 +12,15 @@
 
 pub mod error;
 pub mod export;
+pub mod false_colour;
 pub mod generate;
+pub mod glyphs;
 pub mod intersect;
 pub mod intersect_jobs;
 pub mod mesh;
+pub mod outputs;
 pub mod pipeline;
+pub mod progress;
 pub mod render;
 pub mod report;
 pub mod sample;

@@ -51,6 +51,95 @@ enum Command {
     /// Generate models.
     #[command(subcommand)]
     Generate(GenerateCommand),
+    /// Render a saved solution (from `solve --save`) to PNG, Radiance HDR or OpenEXR.
+    Render(RenderArgs),
+    /// Export a saved solution as a mesh with per-vertex radiosity: PLY or binary glTF.
+    Export(ExportArgs),
+}
+
+/// Checking a saved solution against its scene (optional).
+#[derive(Args, Clone)]
+struct CheckArgs {
+    /// Refuse the solution unless it was solved on this OBJ (same geometry and reflectances;
+    /// emission may differ).
+    #[arg(long, value_name = "FILE.obj")]
+    scene: Option<PathBuf>,
+    /// With --scene: the patch size to check too (default: the solution's own).
+    #[arg(long, value_name = "METRES", requires = "scene")]
+    check_patch_size: Option<f32>,
+}
+
+impl CheckArgs {
+    fn check(&self, two_sided: Option<bool>) -> Option<radiosity::outputs::SceneCheck> {
+        self.scene.as_ref().map(|p| radiosity::outputs::SceneCheck {
+            source: SceneSource::File(p.clone()),
+            load: LoadOptions::default(),
+            patch_size: self.check_patch_size,
+            two_sided,
+        })
+    }
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// The saved solution (`radiosity solve --save FILE.rad`).
+    solution: PathBuf,
+    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiosity, W/m²).
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    check: CheckArgs,
+    /// Camera position X,Y,Z (default: fitted to the scene, looking along −z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    eye: Option<Vec3>,
+    /// Point the camera looks at X,Y,Z (default: the scene's centre).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    target: Option<Vec3>,
+    /// Camera up direction X,Y,Z (default 0,1,0).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    up: Option<Vec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long, allow_negative_numbers = true)]
+    fov: Option<f32>,
+    #[arg(long, default_value_t = 640)]
+    width: u32,
+    #[arg(long, default_value_t = 480)]
+    height: u32,
+    /// Samples per pixel along each axis (edges anti-aliased by s×s supersampling).
+    #[arg(long, default_value_t = 3)]
+    supersample: u32,
+    /// Exposure multiplier on radiosity for PNG (default: automatic).
+    #[arg(long, allow_negative_numbers = true)]
+    exposure: Option<f32>,
+    /// Irradiance in false colour on a log scale, with a legend in W/m² (PNG only).
+    #[arg(long, alias = "false-color")]
+    false_colour: bool,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Args)]
+struct ExportArgs {
+    /// The saved solution (`radiosity solve --save FILE.rad`).
+    solution: PathBuf,
+    /// Mesh to write: .ply or .glb.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    check: CheckArgs,
+    /// Exposure of the display colours (default: automatic, as for images).
+    #[arg(long, allow_negative_numbers = true)]
+    exposure: Option<f32>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
 }
 
 #[derive(Subcommand)]
@@ -361,6 +450,9 @@ struct SolveArgs {
     /// Print the JSON summary on stdout.
     #[arg(long)]
     json: bool,
+    /// Also save the solution to this file (read by `render` and `export`).
+    #[arg(long, value_name = "FILE.rad")]
+    save: Option<PathBuf>,
 }
 
 fn parse_floats<const N: usize>(s: &str) -> Result<[f64; N], String> {
@@ -473,13 +565,16 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                     exposure: a.exposure,
                     ..RenderOptions::default()
                 },
+                save: a.save.clone(),
             };
             let quiet = a.quiet || a.json;
-            let summary = pipeline::run_solve(&job, |line| {
+            let progress = radiosity::progress::Progress::for_terminal(quiet);
+            let summary = pipeline::run_solve_with(&job, &progress, |line| {
                 if !quiet {
-                    eprintln!("{line}");
+                    progress.println(line);
                 }
             })?;
+            drop(progress);
             if a.json {
                 println!(
                     "{}",
@@ -487,17 +582,55 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 );
             } else if !a.quiet {
                 println!(
-                    "{}: {} patches, {} shots, {} rays in {:.2} s; energy balance residual {:.1e}; outputs in {}",
+                    "{}: {} patches, {} shots, {} rays in {:.2} s; {}; energy balance residual {:.1e}; outputs in {}{}",
                     summary.scene,
                     summary.patches,
                     summary.shots,
                     summary.rays,
                     summary.seconds.total,
+                    summary.error_line(),
                     summary.energy.relative_residual,
-                    a.out.display()
+                    a.out.display(),
+                    a.save
+                        .as_ref()
+                        .map(|p| format!(", solution saved to {}", p.display()))
+                        .unwrap_or_default()
                 );
-                println!("{}", summary.error_line());
             }
+            Ok(())
+        }
+        Command::Render(a) => {
+            let job = radiosity::outputs::RenderJob {
+                solution: a.solution,
+                check: a.check.check(None),
+                out: a.out,
+                camera: CameraSpec {
+                    eye: a.eye,
+                    target: a.target,
+                    up: a.up,
+                    fov_y_deg: a.fov,
+                },
+                render: RenderOptions {
+                    width: a.width,
+                    height: a.height,
+                    supersample: a.supersample,
+                    exposure: a.exposure,
+                },
+                false_colour: a.false_colour,
+            };
+            let r = radiosity::outputs::run_render(&job)?;
+            print_output_report(&r, a.json, a.quiet);
+            Ok(())
+        }
+        Command::Export(a) => {
+            let job = radiosity::outputs::ExportJob {
+                solution: a.solution,
+                check: a.check.check(None),
+                out: a.out,
+                exposure: a.exposure,
+            };
+            let r = radiosity::outputs::run_export(&job)?;
+            print_output_report(&r, a.json, a.quiet);
             Ok(())
         }
         Command::Generate(GenerateCommand::Building {
@@ -518,6 +651,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                     floors,
                     rooms_per_floor: rooms,
                     seed,
+                    ..Default::default()
                 },
             };
             let st = generate_building(&out, &opts)?;
@@ -706,6 +840,23 @@ fn crosscheck(a: CrosscheckArgs) -> Result<(), radiosity::Error> {
             c.scene,
             c.report.failures.join("; ")
         )))
+    }
+}
+
+/// The one-line report of `render` and `export`, or its JSON.
+fn print_output_report(r: &radiosity::outputs::OutputReport, json: bool, quiet: bool) {
+    if json {
+        println!("{}", serde_json::to_string_pretty(r).unwrap_or_default());
+    } else if !quiet {
+        let extra = match (&r.scale, r.exposure) {
+            (Some(s), _) => format!(", irradiance {}–{} W/m² on a log scale", s.lo, s.hi),
+            (None, Some(e)) => format!(", exposure {e:.4}"),
+            (None, None) => ", linear radiosity in W/m²".to_string(),
+        };
+        println!(
+            "{}: {} of {} ({} patches, {} vertices){extra}",
+            r.out, r.format, r.scene, r.patches, r.vertices
+        );
     }
 }
 

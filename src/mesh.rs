@@ -28,7 +28,7 @@ pub enum PatchClass {
 
 /// One radiosity element: a planar convex polygon of `count` vertices starting at `first` in
 /// [`Mesh::patch_vertices`], counter-clockwise seen from the front (the side `normal` points to).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Patch {
     pub first: u32,
     pub count: u32,
@@ -42,7 +42,7 @@ pub struct Patch {
 }
 
 /// The patches of a scene and their welded display vertices.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     /// Welded vertex positions (shared by patches of one facing).
     pub vertices: Vec<Vec3>,

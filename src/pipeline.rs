@@ -1,10 +1,12 @@
 //! The pipeline a command runs (DESIGN.md §1): load → mesh → build the intersector → solve →
 //! write the patch table, the image and the JSON summary. The binary only fills a [`SolveJob`].
 
+use crate::export::solution::{self, SavedMaterial, SolutionMeta};
 use crate::export::{self, patches, write_atomic};
 use crate::intersect::select::{self, IntersectorKind};
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::{self, Mesh, MeshOptions};
+use crate::progress::Progress;
 use crate::render::{self, Camera, RenderOptions};
 use crate::report::{self, EnergyReport, Summary, Timings};
 use crate::scene::{self, LoadOptions, Scene};
@@ -67,6 +69,9 @@ pub struct SolveJob {
     pub render: RenderOptions,
     /// A reference patch table (`--reference`): the trace then records the error against it.
     pub reference: Option<PathBuf>,
+    /// Also save the solution here (`--save`), for `render` and `export` (see
+    /// [`crate::export::solution`]).
+    pub save: Option<PathBuf>,
 }
 
 /// Loads the scene named by `source`.
@@ -179,13 +184,26 @@ fn solution_warnings(energy: &EnergyReport) -> Vec<String> {
 }
 
 /// Runs a whole solve and writes its outputs into `job.out`. `log` receives progress lines.
-pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, Error> {
+pub fn run_solve(job: &SolveJob, log: impl FnMut(&str)) -> Result<Summary, Error> {
+    run_solve_with(job, &Progress::hidden(), log)
+}
+
+/// [`run_solve`] with progress bars.
+pub fn run_solve_with(
+    job: &SolveJob,
+    progress: &Progress,
+    mut log: impl FnMut(&str),
+) -> Result<Summary, Error> {
     validate(job)?;
     let t0 = Instant::now();
     let mut timings = Timings::default();
     // Fail on an unwritable folder before spending any time.
     export::prepare_dir(&job.out)?;
+    if let Some(save) = &job.save {
+        check_save_path(save)?;
+    }
 
+    progress.phase("loading");
     let scene = load_scene(&job.source, &job.load)?;
     for w in &scene.warnings {
         log(&format!("warning: {w}"));
@@ -193,6 +211,7 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
     timings.load = t0.elapsed().as_secs_f64();
 
     let t = Instant::now();
+    progress.phase("meshing");
     let m = mesh::build(&scene, &job.mesh);
     timings.mesh = t.elapsed().as_secs_f64();
     if job.mesh.patch_size.is_none() {
@@ -215,6 +234,7 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
 
     // Only the methods that cast rays need an intersector (a scene builds what it needs).
     let t = Instant::now();
+    progress.phase("building the intersectors");
     let (isect, chosen) = if job.solve.method.casts_rays() {
         let (isect, chosen) = select::select(&m, job.intersector)?;
         (Some(isect), Some(chosen))
@@ -231,12 +251,13 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         cfg.reference = Some(std::sync::Arc::new(load_reference(path, &m)?));
     }
     let t = Instant::now();
+    progress.start_solve(emitted_flux(&m, &scene.materials));
     let sol = solve::run(
         &m,
         &scene.materials,
         isect.as_ref(),
         &cfg,
-        |_p: &TracePoint| {},
+        |p: &TracePoint| progress.solve_wave(p),
     )
     .map_err(|source| Error::Solve {
         scene: scene.name.clone(),
@@ -246,6 +267,7 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
     log(&format!("solved: {}", Summary::stats_line(&sol.stats)));
 
     // Outputs.
+    progress.phase("writing outputs");
     let t = Instant::now();
     let mut outputs = Vec::new();
     let csv = job.out.join("patches.csv");
@@ -268,6 +290,11 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         w.write_all(buf.get_ref())
     })?;
     outputs.push(png.display().to_string());
+
+    if let Some(save) = &job.save {
+        save_solution(save, job, &scene, &m, &sol)?;
+        outputs.push(save.display().to_string());
+    }
 
     let energy = EnergyReport::from(&sol.stats.energy);
     let warnings: Vec<String> = scene
@@ -330,7 +357,80 @@ pub fn run_solve(job: &SolveJob, mut log: impl FnMut(&str)) -> Result<Summary, E
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
         writeln!(w)
     })?;
+    progress.finish();
     Ok(summary)
+}
+
+/// Scalar flux the lights emit (W): what the solve's progress is measured against.
+fn emitted_flux(m: &Mesh, materials: &[scene::Material]) -> f64 {
+    m.patches
+        .iter()
+        .map(|p| solve::scalar(&materials[p.material as usize].emission()) * p.area)
+        .sum()
+}
+
+/// Refuses a `--save` path that cannot be written, before any work is spent.
+fn check_save_path(path: &std::path::Path) -> Result<(), Error> {
+    if path.is_dir() {
+        return Err(Error::Invalid(format!(
+            "--save {}: is a folder; give a file name such as solution.rad",
+            path.display()
+        )));
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(dir) = parent {
+        if !dir.is_dir() {
+            return Err(Error::Invalid(format!(
+                "--save {}: the folder {} does not exist",
+                path.display(),
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Writes the saved solution of a finished solve (`--save`).
+fn save_solution(
+    path: &std::path::Path,
+    job: &SolveJob,
+    scene: &Scene,
+    m: &Mesh,
+    sol: &solve::Solution,
+) -> Result<(), Error> {
+    let meta = SolutionMeta {
+        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        scene: scene.name.clone(),
+        scene_hash: solution::scene_hash(scene, m.patch_size, job.mesh.two_sided),
+        patch_size: m.patch_size,
+        two_sided: job.mesh.two_sided,
+        method: job.solve.method.name().to_string(),
+        seed: job.solve.seed,
+        tolerance: job.solve.tolerance,
+        energy_per_ray: sol.stats.energy_per_ray,
+        stop_fraction: job.solve.stop_fraction,
+        stop_reason: sol
+            .stats
+            .stop_reason
+            .and_then(|r| serde_json::to_value(r).ok())
+            .and_then(|v| v.as_str().map(str::to_string)),
+        shots: sol.stats.shots,
+        rays: sol.stats.rays,
+        materials: scene
+            .materials
+            .iter()
+            .map(|mat| SavedMaterial {
+                name: mat.name.clone(),
+                rho: mat.rho,
+                ke: mat.ke,
+            })
+            .collect(),
+    };
+    let vertex_b = m.vertex_values(&sol.b);
+    write_atomic(path, |w| {
+        solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &[])
+    })?;
+    Ok(())
 }
 
 /// Renders patch radiosities, Gouraud-interpolated at the welded vertices, tone-mapped.

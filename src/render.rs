@@ -514,7 +514,8 @@ pub fn tone_map(img: &LinearImage, exposure: Option<f32>) -> (image::RgbImage, f
 }
 
 /// The exposure that maps the 97th luminance percentile of the lit pixels to 0.9 (1 if none).
-fn auto_exposure(pixels: &[[f32; 3]]) -> f32 {
+/// Also used for the 8-bit colours of exported meshes.
+pub fn auto_exposure(pixels: &[[f32; 3]]) -> f32 {
     let mut lum: Vec<f32> = pixels
         .iter()
         .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
@@ -534,7 +535,7 @@ fn auto_exposure(pixels: &[[f32; 3]]) -> f32 {
 }
 
 /// The sRGB transfer curve (IEC 61966-2-1) for v in [0, 1].
-fn srgb_encode(v: f32) -> f32 {
+pub fn srgb_encode(v: f32) -> f32 {
     if v <= 0.003_130_8 {
         12.92 * v
     } else {

@@ -266,13 +266,13 @@ impl Summary {
     pub fn error_line(&self) -> String {
         let e = &self.error_estimate;
         let est = format!(
-            "estimated error {:.2} % (average weighted percent), {:.2} % (average energy)",
+            "estimated error {:.2} % average weighted, {:.2} % energy",
             100.0 * e.weighted_percent,
             100.0 * e.energy
         );
         match &self.error {
             Some(r) => format!(
-                "error against the reference {:.2} % (average weighted percent), {:.2} % (average energy), {:.2} % RMS; {est}",
+                "error against the reference {:.2} % average weighted, {:.2} % energy, {:.2} % RMS ({est})",
                 100.0 * r.weighted_percent,
                 100.0 * r.energy,
                 100.0 * r.rms_relative

@@ -1,7 +1,11 @@
 //! Files other tools read (DESIGN.md §5). Every file is written whole or not at all: into a
 //! temporary name beside the target, then renamed, so no partial file is left behind.
 
+pub mod glb;
+pub mod image;
 pub mod patches;
+pub mod ply;
+pub mod solution;
 pub mod trace;
 
 use std::io::Write;
@@ -51,4 +55,30 @@ pub fn prepare_dir(dir: &Path) -> Result<(), WriteError> {
     let probe = dir.join(".radiosity-write-test");
     std::fs::write(&probe, b"").map_err(err)?;
     std::fs::remove_file(&probe).map_err(err)
+}
+
+/// The exposure for display colours of per-vertex radiosity: `Some(e)` (finite, ≥ 0) as given,
+/// else automatic as for images ([`crate::render::auto_exposure`]).
+pub fn vertex_exposure(vertex_b: &[[f32; 3]], exposure: Option<f32>) -> f32 {
+    match exposure {
+        Some(e) if e.is_finite() && e >= 0.0 => e,
+        _ => crate::render::auto_exposure(vertex_b),
+    }
+}
+
+/// Linear radiosity × exposure, clamped to [0, 1] (0 for non-finite values).
+pub fn exposed(rgb: [f32; 3], exposure: f32) -> [f32; 3] {
+    rgb.map(|c| {
+        let v = c * exposure;
+        if v.is_finite() {
+            v.clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    })
+}
+
+/// Tone-mapped 8-bit sRGB of a linear radiosity (as the PNG renders show it).
+pub fn srgb8(rgb: [f32; 3], exposure: f32) -> [u8; 3] {
+    exposed(rgb, exposure).map(|v| (crate::render::srgb_encode(v) * 255.0).round() as u8)
 }

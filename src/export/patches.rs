@@ -68,7 +68,7 @@ impl Row {
     }
 }
 
-/// Reads a patch table written by [`write`] (for references and comparisons).
+/// Reads a patch table written by [`write`](fn@write) (for references and comparisons).
 pub fn read(r: impl BufRead) -> io::Result<Vec<Row>> {
     let bad = |line: usize, what: &str| {
         io::Error::new(io::ErrorKind::InvalidData, format!("line {line}: {what}"))

@@ -122,7 +122,7 @@ pub enum StopReason {
 }
 
 /// One point of the convergence trace.
-#[derive(Clone, Copy, Debug, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
 pub struct TracePoint {
     pub time_s: f64,
     pub shots: u64,
