@@ -55,6 +55,33 @@ enum Command {
     Render(RenderArgs),
     /// Export a saved solution as a mesh with per-vertex radiosity: PLY or binary glTF.
     Export(ExportArgs),
+    /// Re-weight the lights of a solution saved with --per-light, without solving again, and
+    /// render it (.png/.hdr/.exr) or export it (.ply/.glb).
+    Relight(RelightArgs),
+}
+
+#[derive(Args)]
+struct RelightArgs {
+    /// LIGHT=WEIGHT (repeatable): scale that light's channel (its name as `solve --per-light`
+    /// printed it); lights not named keep weight 1.
+    #[arg(long = "weight", value_name = "LIGHT=W", value_parser = parse_weight)]
+    weights: Vec<(String, f64)>,
+    #[command(flatten)]
+    render: RenderArgs,
+}
+
+fn parse_weight(s: &str) -> Result<(String, f64), String> {
+    let (name, w) = s
+        .rsplit_once('=')
+        .ok_or_else(|| format!("expected LIGHT=WEIGHT, got '{s}'"))?;
+    let w: f64 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{w}' is not a number in '{s}'"))?;
+    if !(w.is_finite() && w >= 0.0) {
+        return Err(format!("the weight in '{s}' must be a finite number ≥ 0"));
+    }
+    Ok((name.trim().to_string(), w))
 }
 
 /// Checking a saved solution against its scene (optional).
@@ -380,6 +407,24 @@ fn parse_sizes(s: &str) -> Result<Sizes, String> {
         .map(Sizes)
 }
 
+/// `--light-groups`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum LightGroupsArg {
+    /// One channel per emitting material.
+    Material,
+    /// One channel per connected emitting surface (fixtures of one material apart).
+    Connected,
+}
+
+impl From<LightGroupsArg> for radiosity::solve::lights::GroupBy {
+    fn from(a: LightGroupsArg) -> Self {
+        match a {
+            LightGroupsArg::Material => radiosity::solve::lights::GroupBy::Material,
+            LightGroupsArg::Connected => radiosity::solve::lights::GroupBy::Connected,
+        }
+    }
+}
+
 /// `--method`: see `radiosity::solve::MethodKind`.
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum Method {
@@ -450,9 +495,16 @@ struct SolveArgs {
     /// Print the JSON summary on stdout.
     #[arg(long)]
     json: bool,
-    /// Also save the solution to this file (read by `render` and `export`).
+    /// Also save the solution to this file (read by `render`, `export` and `relight`).
     #[arg(long, value_name = "FILE.rad")]
     save: Option<PathBuf>,
+    /// Keep one channel per light (saved with --save), so `radiosity relight` can re-weight
+    /// the lights without solving again.
+    #[arg(long)]
+    per_light: bool,
+    /// With --per-light: one channel per emitting material, or per connected emitting surface.
+    #[arg(long, value_enum, default_value_t = LightGroupsArg::Material, requires = "per_light")]
+    light_groups: LightGroupsArg,
 }
 
 fn parse_floats<const N: usize>(s: &str) -> Result<[f64; N], String> {
@@ -538,6 +590,7 @@ impl SolverArgs {
             gather_cap_mib: self.gather_cap_mib,
             switch_at: self.switch_at,
             reference: None,
+            light_groups: None,
         })
     }
 }
@@ -566,6 +619,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                     ..RenderOptions::default()
                 },
                 save: a.save.clone(),
+                per_light: a.per_light.then_some(a.light_groups.into()),
             };
             let quiet = a.quiet || a.json;
             let progress = radiosity::progress::Progress::for_terminal(quiet);
@@ -600,26 +654,19 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
             Ok(())
         }
         Command::Render(a) => {
-            let job = radiosity::outputs::RenderJob {
-                solution: a.solution,
-                check: a.check.check(None),
-                out: a.out,
-                camera: CameraSpec {
-                    eye: a.eye,
-                    target: a.target,
-                    up: a.up,
-                    fov_y_deg: a.fov,
-                },
-                render: RenderOptions {
-                    width: a.width,
-                    height: a.height,
-                    supersample: a.supersample,
-                    exposure: a.exposure,
-                },
-                false_colour: a.false_colour,
+            let (json, quiet) = (a.json, a.quiet);
+            let r = radiosity::outputs::run_render(&render_job(a))?;
+            print_output_report(&r, json, quiet);
+            Ok(())
+        }
+        Command::Relight(a) => {
+            let (json, quiet) = (a.render.json, a.render.quiet);
+            let job = radiosity::outputs::RelightJob {
+                render: render_job(a.render),
+                weights: a.weights,
             };
-            let r = radiosity::outputs::run_render(&job)?;
-            print_output_report(&r, a.json, a.quiet);
+            let r = radiosity::outputs::run_relight(&job)?;
+            print_output_report(&r, json, quiet);
             Ok(())
         }
         Command::Export(a) => {
@@ -840,6 +887,27 @@ fn crosscheck(a: CrosscheckArgs) -> Result<(), radiosity::Error> {
             c.scene,
             c.report.failures.join("; ")
         )))
+    }
+}
+
+fn render_job(a: RenderArgs) -> radiosity::outputs::RenderJob {
+    radiosity::outputs::RenderJob {
+        solution: a.solution,
+        check: a.check.check(None),
+        out: a.out,
+        camera: CameraSpec {
+            eye: a.eye,
+            target: a.target,
+            up: a.up,
+            fov_y_deg: a.fov,
+        },
+        render: RenderOptions {
+            width: a.width,
+            height: a.height,
+            supersample: a.supersample,
+            exposure: a.exposure,
+        },
+        false_colour: a.false_colour,
     }
 }
 

@@ -72,6 +72,8 @@ pub struct SolveJob {
     /// Also save the solution here (`--save`), for `render` and `export` (see
     /// [`crate::export::solution`]).
     pub save: Option<PathBuf>,
+    /// Keep per-light channels, grouped so (`--per-light`, `--light-groups`).
+    pub per_light: Option<solve::lights::GroupBy>,
 }
 
 /// Loads the scene named by `source`.
@@ -247,6 +249,15 @@ pub fn run_solve_with(
     }
 
     let mut cfg = job.solve.clone();
+    if let Some(by) = job.per_light {
+        let g = solve::lights::groups(&scene, &m, by);
+        log(&format!(
+            "per-light channels: {} ({})",
+            g.len(),
+            g.names.join(", ")
+        ));
+        cfg.light_groups = Some(std::sync::Arc::new(g));
+    }
     if let Some(path) = &job.reference {
         cfg.reference = Some(std::sync::Arc::new(load_reference(path, &m)?));
     }
@@ -345,6 +356,7 @@ pub fn run_solve_with(
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
         seconds: timings,
         energy,
+        light_channels: sol.channels.iter().map(|c| c.name.clone()).collect(),
         error_estimate: last.map(|p| p.estimate).unwrap_or_default(),
         error: last.and_then(|p| p.error),
         max_unshot_over_mean: last
@@ -427,8 +439,16 @@ fn save_solution(
             .collect(),
     };
     let vertex_b = m.vertex_values(&sol.b);
+    let channels: Vec<solution::LightChannel> = sol
+        .channels
+        .iter()
+        .map(|c| solution::LightChannel {
+            name: c.name.clone(),
+            b: c.b.clone(),
+        })
+        .collect();
     write_atomic(path, |w| {
-        solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &[])
+        solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &channels)
     })?;
     Ok(())
 }

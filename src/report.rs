@@ -249,6 +249,8 @@ pub struct Summary {
     pub rays_per_second: f64,
     pub seconds: Timings,
     pub energy: EnergyReport,
+    /// Names of the per-light channels kept (`--per-light`), in channel order.
+    pub light_channels: Vec<String>,
     /// The solver's own estimate of its final error (fractions; see `solve::error`).
     pub error_estimate: ErrorMetrics,
     /// The final error against `--reference`, when given.

@@ -55,6 +55,8 @@ pub struct CubeShot {
     pub index: u64,
     /// The flux it shoots, RGB.
     pub phi: [f64; 3],
+    /// The same per light channel (empty without `--per-light`).
+    pub ch: Vec<[f64; 3]>,
     pub cube: Arc<Hemicube>,
 }
 
@@ -167,6 +169,9 @@ pub(super) fn apply(st: &mut State, shot: &CubeShot, hits: &CubeHits) {
             st.deposit_back(&phi);
         } else {
             st.deposit_cube(j as usize, &phi, e_cell);
+            if !shot.ch.is_empty() {
+                st.deposit_channels(j as usize, &shot.ch, f);
+            }
         }
         seen += f;
     }

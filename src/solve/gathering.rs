@@ -239,12 +239,12 @@ pub fn shoot_matrix(
 pub fn gather(
     mesh: &Mesh,
     materials: &[Material],
-    n_cube: usize,
-    seed: u64,
-    stop_fraction: f64,
-    reference: Option<&[[f64; 3]]>,
+    cfg: &super::SolveConfig,
     mut on_trace: impl FnMut(&TracePoint),
 ) -> Solution {
+    let (n_cube, seed, stop_fraction) = (cfg.hemicube_n, cfg.seed, cfg.stop_fraction);
+    let reference = cfg.reference.as_deref().map(Vec::as_slice);
+    let light_groups = cfg.light_groups.as_deref();
     let start = Instant::now();
     let n = mesh.patches.len();
     let ff = FormFactors::by_hemicube(mesh, n_cube, seed);
@@ -361,10 +361,31 @@ pub fn gather(
         trace,
         ..SolveStats::default()
     };
+    // Per-light channels: the same matrix, each light's emission alone (B is linear in E).
+    let channels = light_groups
+        .map(|g| {
+            g.names
+                .iter()
+                .enumerate()
+                .map(|(c, name)| {
+                    let e_c: Vec<[f64; 3]> = e
+                        .iter()
+                        .zip(&g.of_patch)
+                        .map(|(e, &grp)| if grp as usize == c { *e } else { [0.0; 3] })
+                        .collect();
+                    super::Channel {
+                        name: name.clone(),
+                        b: gauss_seidel(&ff, &e_c, &rho, &area, stop_fraction, 100_000).0,
+                    }
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     Solution {
         b,
         unshot: vec![[0.0; 3]; n],
         stats,
+        channels,
     }
 }
 

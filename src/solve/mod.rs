@@ -10,6 +10,7 @@
 pub mod cube_shots;
 pub mod error;
 pub mod gathering;
+pub mod lights;
 pub mod progressive;
 mod state;
 
@@ -88,6 +89,9 @@ pub struct SolveConfig {
     /// Radiosity per patch of a reference solution (`--reference`): every trace point then
     /// records the error against it.
     pub reference: Option<std::sync::Arc<Vec<[f64; 3]>>>,
+    /// Keep one channel per light group (`--per-light`): the solution then carries each
+    /// light's own radiosity, for relighting without solving again.
+    pub light_groups: Option<std::sync::Arc<lights::LightGroups>>,
 }
 
 impl Default for SolveConfig {
@@ -105,6 +109,7 @@ impl Default for SolveConfig {
             gather_cap_mib: 4096,
             switch_at: None,
             reference: None,
+            light_groups: None,
         }
     }
 }
@@ -224,6 +229,16 @@ pub struct Solution {
     /// Unshot flux ΔΦ_i per patch (W), RGB.
     pub unshot: Vec<[f64; 3]>,
     pub stats: SolveStats,
+    /// Per light group, the radiosity with only that light on (empty unless asked for); they
+    /// sum to `b` (to rounding).
+    pub channels: Vec<Channel>,
+}
+
+/// One light group's radiosity per patch (W/m², RGB).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channel {
+    pub name: String,
+    pub b: Vec<[f64; 3]>,
 }
 
 /// The scalar the solver ranks and stops by: the mean of the three channels.
@@ -285,15 +300,7 @@ pub fn run<I: Intersector>(
                     });
                 }
             }
-            Ok(gathering::gather(
-                mesh,
-                materials,
-                cfg.hemicube_n,
-                cfg.seed,
-                cfg.stop_fraction,
-                cfg.reference.as_deref().map(Vec::as_slice),
-                on_trace,
-            ))
+            Ok(gathering::gather(mesh, materials, cfg, on_trace))
         }
         _ => progressive::shoot(mesh, materials, isect, cfg, on_trace),
     }

@@ -64,6 +64,8 @@ struct Shot {
     index: u64,
     /// The flux it shoots, RGB.
     phi: [f64; 3],
+    /// The same per light channel (empty without `--per-light`).
+    ch: Vec<[f64; 3]>,
     grid: PolarGrid,
 }
 
@@ -165,6 +167,7 @@ impl<I: Intersector> Ctx<'_, I> {
             patch,
             index: u64::MAX - 1,
             phi: [0.0; 3],
+            ch: Vec::new(),
             grid: PolarGrid::for_samples((4 * CHUNK) as f64),
         };
         let tasks = tasks_of(std::slice::from_ref(&shot));
@@ -212,6 +215,7 @@ pub fn seconds_per_ray<I: Intersector>(
             patch: i,
             index: k as u64,
             phi: [0.0; 3],
+            ch: Vec::new(),
             grid: PolarGrid::for_samples(rays_per_shot as f64),
         };
         for task in tasks_of(std::slice::from_ref(&shot)) {
@@ -225,7 +229,8 @@ pub fn seconds_per_ray<I: Intersector>(
 fn apply_rays(st: &mut State, wave: &[Shot], tasks: &[Task], hits: &[Vec<u32>]) {
     for (task, codes) in tasks.iter().zip(hits) {
         let shot = &wave[task.shot];
-        let phi_ray = shot.phi.map(|p| p / shot.grid.len() as f64);
+        let per_ray = 1.0 / shot.grid.len() as f64;
+        let phi_ray = shot.phi.map(|p| p * per_ray);
         for &code in codes {
             if code == ESCAPED {
                 st.escape(&phi_ray);
@@ -233,6 +238,9 @@ fn apply_rays(st: &mut State, wave: &[Shot], tasks: &[Task], hits: &[Vec<u32>]) 
                 st.deposit_back(&phi_ray);
             } else {
                 st.deposit(code as usize, &phi_ray);
+                if !shot.ch.is_empty() {
+                    st.deposit_channels(code as usize, &shot.ch, per_ray);
+                }
             }
         }
         st.rays += codes.len() as u64;
@@ -299,6 +307,9 @@ pub fn shoot<I: Intersector>(
     let mut st = State::new(mesh, materials, cfg.stop_fraction);
     if scalar(&st.energy.emitted) <= 0.0 {
         return Err(SolveError::NoEmitter);
+    }
+    if let Some(g) = &cfg.light_groups {
+        st.start_channels(&g.of_patch, g.len());
     }
     if let Some(r) = &cfg.reference {
         if r.len() != n {
@@ -473,10 +484,12 @@ pub fn shoot<I: Intersector>(
                     }
                 }
                 let (patch, phi) = st.take_shooter().expect("peeked");
+                let ch = st.take_channels(patch);
                 wave.push(CubeShot {
                     patch,
                     index: stats.shots,
                     phi,
+                    ch,
                     cube,
                 });
                 stats.shots += 1;
@@ -509,12 +522,14 @@ pub fn shoot<I: Intersector>(
             let Some((i, phi)) = st.take_shooter() else {
                 break;
             };
+            let ch = st.take_channels(i);
             let grid = PolarGrid::for_samples(scalar(&phi) / c_ray);
             wave_rays += grid.len();
             wave.push(Shot {
                 patch: i,
                 index: stats.shots,
                 phi,
+                ch,
                 grid,
             });
             stats.shots += 1;
@@ -549,9 +564,22 @@ pub fn shoot<I: Intersector>(
     stats.energy = st.energy;
     stats.stop_reason = Some(stop_reason);
     stats.seconds = start.elapsed().as_secs_f64();
+    let channels = match &cfg.light_groups {
+        Some(g) => st
+            .channel_radiosity(mesh, materials, &g.of_patch)
+            .into_iter()
+            .zip(&g.names)
+            .map(|(b, name)| super::Channel {
+                name: name.clone(),
+                b,
+            })
+            .collect(),
+        None => Vec::new(),
+    };
     Ok(Solution {
         b: st.radiosity(mesh, materials),
         unshot: st.patches.iter().map(|p| p.unshot).collect(),
         stats,
+        channels,
     })
 }

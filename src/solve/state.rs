@@ -84,6 +84,17 @@ pub(super) struct PatchState {
     pub inv_area: f32,
 }
 
+/// Per-light channels (`--per-light`, Images 1a/1b): one unshot and one kept flux per light
+/// group and patch, `k` groups side by side per patch. A shot sends every channel of its
+/// shooter along the same samples, so the channels sum to the combined solution (to rounding)
+/// and each one is the solution with only its light on. Absent unless asked for: a solve
+/// without it allocates nothing per light.
+pub(super) struct Channels {
+    pub k: usize,
+    pub unshot: Vec<[f64; 3]>,
+    pub gathered: Vec<[f64; 3]>,
+}
+
 /// The solver's mutable state: patches, heaps and energy accounts.
 pub(super) struct State {
     pub patches: Vec<PatchState>,
@@ -109,6 +120,7 @@ pub(super) struct State {
     /// variance Σ ρ·e_cell·kept (see [`super::error`]). Empty until a hemi-cube shot lands.
     cube_gathered: Vec<f64>,
     cube_var: Vec<f64>,
+    pub channels: Option<Channels>,
 }
 
 impl State {
@@ -145,6 +157,7 @@ impl State {
             rho_max: 0.0,
             cube_gathered: Vec::new(),
             cube_var: Vec::new(),
+            channels: None,
         };
         let mut rho_area = 0.0;
         for (p, s) in mesh.patches.iter().zip(&st.patches) {
@@ -224,6 +237,79 @@ impl State {
         self.by_flux.heap.pop();
         self.shot_flux += flux;
         Some((i, std::mem::take(&mut self.patches[i].unshot)))
+    }
+
+    /// Starts per-light channels: `group[j]` is patch j's light group (`u32::MAX`: not a
+    /// light), `k` groups in all; each light's emission starts in its own channel.
+    pub fn start_channels(&mut self, group: &[u32], k: usize) {
+        let n = self.patches.len();
+        let mut ch = Channels {
+            k,
+            unshot: vec![[0.0; 3]; n * k],
+            gathered: vec![[0.0; 3]; n * k],
+        };
+        for (j, &g) in group.iter().enumerate() {
+            if (g as usize) < k {
+                ch.unshot[j * k + g as usize] = self.patches[j].unshot;
+            }
+        }
+        self.channels = Some(ch);
+    }
+
+    /// The shooter's unshot flux per channel, zeroed (call right after `take_shooter`).
+    pub fn take_channels(&mut self, i: usize) -> Vec<[f64; 3]> {
+        match &mut self.channels {
+            Some(ch) => ch.unshot[i * ch.k..(i + 1) * ch.k]
+                .iter_mut()
+                .map(std::mem::take)
+                .collect(),
+            None => Vec::new(),
+        }
+    }
+
+    /// Patch j receives `scale` of every channel of a shot (`shot_ch`, per channel flux).
+    #[inline]
+    pub fn deposit_channels(&mut self, j: usize, shot_ch: &[[f64; 3]], scale: f64) {
+        if let Some(ch) = &mut self.channels {
+            let rho = self.patches[j].rho;
+            let k = ch.k;
+            for (c, phi) in shot_ch.iter().enumerate() {
+                for (x, r) in rho.iter().enumerate() {
+                    let kept = *r as f64 * phi[x] * scale;
+                    ch.unshot[j * k + c][x] += kept;
+                    ch.gathered[j * k + c][x] += kept;
+                }
+            }
+        }
+    }
+
+    /// Radiosity per channel and patch: B_j^c = E_j (if j is light c) + gathered_j^c / A_j.
+    pub fn channel_radiosity(
+        &self,
+        mesh: &Mesh,
+        materials: &[Material],
+        group: &[u32],
+    ) -> Vec<Vec<[f64; 3]>> {
+        let Some(ch) = &self.channels else {
+            return Vec::new();
+        };
+        (0..ch.k)
+            .map(|c| {
+                mesh.patches
+                    .iter()
+                    .enumerate()
+                    .map(|(j, p)| {
+                        let e = if group[j] as usize == c {
+                            materials[p.material as usize].emission()
+                        } else {
+                            [0.0; 3]
+                        };
+                        let g = ch.gathered[j * ch.k + c];
+                        [0, 1, 2].map(|x| e[x] + g[x] / p.area)
+                    })
+                    .collect()
+            })
+            .collect()
     }
 
     /// Flux `phi` arrives on the front of patch `j`: ρ_j·phi is kept (and will be shot on),

@@ -1,0 +1,128 @@
+//! Light groups for per-light channels (`--per-light`, `--light-groups`; the paper's Images
+//! 1a/1b, where two ceiling lights were re-weighted in real time without solving again).
+//!
+//! A group is either every patch of one emitting material, or one connected emitting surface
+//! (emitting polygons that share a vertex position), so two fixtures of the same material can
+//! be dimmed apart.
+
+use crate::mesh::Mesh;
+use crate::scene::Scene;
+
+/// How lights are grouped into channels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum GroupBy {
+    /// One channel per emitting material (named after it).
+    #[default]
+    Material,
+    /// One channel per connected emitting surface (named `material#k`).
+    Connected,
+}
+
+/// The light group of every patch.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightGroups {
+    pub names: Vec<String>,
+    /// Group per patch, `u32::MAX` for patches that do not emit.
+    pub of_patch: Vec<u32>,
+}
+
+impl LightGroups {
+    pub fn len(&self) -> usize {
+        self.names.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.names.is_empty()
+    }
+}
+
+/// Groups the emitting patches of `mesh` (built from `scene`).
+pub fn groups(scene: &Scene, mesh: &Mesh, by: GroupBy) -> LightGroups {
+    let emits = |material: u32| scene.materials[material as usize].is_emitter();
+    // Group per polygon first.
+    let npoly = scene.polygons.len();
+    let mut poly_group = vec![u32::MAX; npoly];
+    let mut names = Vec::new();
+    match by {
+        GroupBy::Material => {
+            let mut of_material = vec![u32::MAX; scene.materials.len()];
+            for (k, poly) in scene.polygons.iter().enumerate() {
+                if emits(poly.material) {
+                    let m = poly.material as usize;
+                    if of_material[m] == u32::MAX {
+                        of_material[m] = names.len() as u32;
+                        names.push(scene.materials[m].name.clone());
+                    }
+                    poly_group[k] = of_material[m];
+                }
+            }
+        }
+        GroupBy::Connected => {
+            // Union-find over emitting polygons of one material sharing a vertex position.
+            let mut parent: Vec<usize> = (0..npoly).collect();
+            fn find(parent: &mut [usize], mut x: usize) -> usize {
+                while parent[x] != x {
+                    parent[x] = parent[parent[x]];
+                    x = parent[x];
+                }
+                x
+            }
+            let mut at: std::collections::HashMap<([u32; 3], u32), usize> =
+                std::collections::HashMap::new();
+            for (k, poly) in scene.polygons.iter().enumerate() {
+                if !emits(poly.material) {
+                    continue;
+                }
+                let idx = &scene.indices[poly.first as usize..(poly.first + poly.len) as usize];
+                for &v in idx {
+                    let p = scene.positions[v as usize];
+                    let key = ([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()], poly.material);
+                    match at.get(&key) {
+                        Some(&other) => {
+                            let (a, b) = (find(&mut parent, k), find(&mut parent, other));
+                            if a != b {
+                                parent[a.max(b)] = a.min(b);
+                            }
+                        }
+                        None => {
+                            at.insert(key, k);
+                        }
+                    }
+                }
+            }
+            let mut of_root = std::collections::HashMap::new();
+            let mut count_of_material = vec![0usize; scene.materials.len()];
+            for (k, poly) in scene.polygons.iter().enumerate() {
+                if !emits(poly.material) {
+                    continue;
+                }
+                let root = find(&mut parent, k);
+                let g = *of_root.entry(root).or_insert_with(|| {
+                    let m = poly.material as usize;
+                    count_of_material[m] += 1;
+                    names.push(format!(
+                        "{}#{}",
+                        scene.materials[m].name, count_of_material[m]
+                    ));
+                    names.len() as u32 - 1
+                });
+                poly_group[k] = g;
+            }
+        }
+    }
+    let of_patch = mesh
+        .patches
+        .iter()
+        .map(|p| {
+            if emits(p.material) {
+                poly_group
+                    .get(p.polygon as usize)
+                    .copied()
+                    .unwrap_or(u32::MAX)
+            } else {
+                u32::MAX
+            }
+        })
+        .collect();
+    LightGroups { names, of_patch }
+}
