@@ -502,6 +502,22 @@ struct SolveArgs {
     /// the lights without solving again.
     #[arg(long)]
     per_light: bool,
+    /// Write the solver's state to this file (atomically) every --checkpoint-every seconds and
+    /// on Ctrl-C; `--resume FILE` continues from it.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 60.0,
+        requires = "checkpoint",
+        allow_negative_numbers = true
+    )]
+    checkpoint_every: f64,
+    /// Continue a solve from a checkpoint of the same scene and settings.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
     /// With --per-light: one channel per emitting material, or per connected emitting surface.
     #[arg(long, value_enum, default_value_t = LightGroupsArg::Material, requires = "per_light")]
     light_groups: LightGroupsArg,
@@ -589,8 +605,7 @@ impl SolverArgs {
             hemicube_n: self.hemicube_n,
             gather_cap_mib: self.gather_cap_mib,
             switch_at: self.switch_at,
-            reference: None,
-            light_groups: None,
+            ..SolveConfig::default()
         })
     }
 }
@@ -620,6 +635,10 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 },
                 save: a.save.clone(),
                 per_light: a.per_light.then_some(a.light_groups.into()),
+                checkpoint: a.checkpoint.clone(),
+                checkpoint_every: a.checkpoint_every,
+                resume: a.resume.clone(),
+                interrupt: Some(interrupt_flag()),
             };
             let quiet = a.quiet || a.json;
             let progress = radiosity::progress::Progress::for_terminal(quiet);
@@ -650,6 +669,16 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                         .map(|p| format!(", solution saved to {}", p.display()))
                         .unwrap_or_default()
                 );
+            }
+            if summary.stop_reason == Some(radiosity::solve::StopReason::Interrupted) {
+                eprintln!(
+                    "interrupted: the outputs hold the solution so far{}",
+                    a.checkpoint
+                        .as_ref()
+                        .map(|p| format!("; continue with --resume {}", p.display()))
+                        .unwrap_or_default()
+                );
+                std::process::exit(130);
             }
             Ok(())
         }
@@ -951,6 +980,21 @@ fn generate_building(
     })?;
     write_atomic(&mtl_path, |w| w.write_all(&mtl_text))?;
     stats.ok_or_else(|| radiosity::Error::Invalid("the generator wrote nothing".into()))
+}
+
+/// Ctrl-C asks the solve to stop at its next safe point (writing a checkpoint if asked, then
+/// its outputs); a second Ctrl-C ends the process at once.
+fn interrupt_flag() -> std::sync::Arc<std::sync::atomic::AtomicBool> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let flag = std::sync::Arc::new(AtomicBool::new(false));
+    let f = flag.clone();
+    let _ = ctrlc::set_handler(move || {
+        if f.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("\nstopping at the next safe point (Ctrl-C again to quit at once)…");
+    });
+    flag
 }
 
 fn main() -> ExitCode {

@@ -74,6 +74,13 @@ pub struct SolveJob {
     pub save: Option<PathBuf>,
     /// Keep per-light channels, grouped so (`--per-light`, `--light-groups`).
     pub per_light: Option<solve::lights::GroupBy>,
+    /// Checkpoint file (`--checkpoint`) and seconds between checkpoints.
+    pub checkpoint: Option<PathBuf>,
+    pub checkpoint_every: f64,
+    /// Continue from this checkpoint (`--resume`).
+    pub resume: Option<PathBuf>,
+    /// Set on Ctrl-C: stop at the next safe point.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 /// Loads the scene named by `source`.
@@ -87,6 +94,17 @@ pub fn load_scene(source: &SceneSource, opts: &LoadOptions) -> Result<Scene, Err
 /// Checks settings a user can get wrong, before any work.
 pub fn validate(job: &SolveJob) -> Result<(), Error> {
     let s = &job.solve;
+    if (job.checkpoint.is_some() || job.resume.is_some()) && s.method == MethodKind::Gathering {
+        return Err(Error::Invalid(
+            "--checkpoint and --resume need a shooting method: gathering has no useful state before it converges".into(),
+        ));
+    }
+    if !(job.checkpoint_every > 0.0 && job.checkpoint_every.is_finite()) {
+        return Err(Error::Invalid(format!(
+            "--checkpoint-every must be a positive number of seconds, got {}",
+            job.checkpoint_every
+        )));
+    }
     if s.switch_at.is_some() && s.method != MethodKind::AdaptiveHybrid {
         return Err(Error::Invalid(format!(
             "--switch-at applies to --method adaptive-hybrid only, not {}",
@@ -171,6 +189,25 @@ pub fn load_reference(path: &std::path::Path, m: &Mesh) -> Result<Vec<[f64; 3]>,
         }
     }
     Ok(rows.iter().map(|r| r.b()).collect())
+}
+
+/// What a checkpoint must match to be resumed: the scene and mesh (hash), and every setting
+/// that shapes the result.
+fn checkpoint_key(job: &SolveJob, scene: &Scene, m: &Mesh) -> String {
+    let s = &job.solve;
+    format!(
+        "scene {:016x}, method {}, seed {}, tolerance {}, energy per ray {:?}, stop {}, hemicube-n {}, jitter {}, switch-at {:?}, per-light {:?}",
+        crate::export::solution::scene_hash(scene, m.patch_size, job.mesh.two_sided),
+        s.method.name(),
+        s.seed,
+        s.tolerance,
+        s.energy_per_ray,
+        s.stop_fraction,
+        s.hemicube_n,
+        s.jitter,
+        s.switch_at,
+        job.per_light.map(|g| format!("{g:?}"))
+    )
 }
 
 /// Warnings about a solution a user should hear of.
@@ -260,6 +297,36 @@ pub fn run_solve_with(
     }
     if let Some(path) = &job.reference {
         cfg.reference = Some(std::sync::Arc::new(load_reference(path, &m)?));
+    }
+    cfg.interrupt = job.interrupt.clone();
+    if job.checkpoint.is_some() || job.resume.is_some() {
+        let key = checkpoint_key(job, &scene, &m);
+        if let Some(path) = &job.checkpoint {
+            let path = path.clone();
+            cfg.checkpoint = Some(solve::checkpoint::Sink {
+                every: std::time::Duration::from_secs_f64(job.checkpoint_every),
+                write: std::sync::Arc::new(move |snap: &solve::checkpoint::Snapshot| {
+                    let mut snap_keyed = snap.clone();
+                    snap_keyed.header.key = key.clone();
+                    let bytes = snap_keyed.to_bytes();
+                    write_atomic(&path, |w| w.write_all(&bytes)).map_err(|e| e.to_string())
+                }),
+            });
+        }
+        if let Some(path) = &job.resume {
+            let what = path.display().to_string();
+            let bytes = std::fs::read(path)
+                .map_err(|e| Error::Invalid(format!("--resume {what}: cannot read it ({e})")))?;
+            let snap =
+                solve::checkpoint::Snapshot::from_bytes(&what, &bytes).map_err(Error::Invalid)?;
+            snap.check_key(&what, &checkpoint_key(job, &scene, &m))
+                .map_err(Error::Invalid)?;
+            log(&format!(
+                "resuming from {what}: {} shots, {:.1} s done",
+                snap.header.shots, snap.header.elapsed
+            ));
+            cfg.resume = Some(std::sync::Arc::new(snap));
+        }
     }
     let t = Instant::now();
     progress.start_solve(emitted_flux(&m, &scene.materials));

@@ -204,6 +204,21 @@ pub struct CubeCost {
 }
 
 impl CubeCost {
+    /// The running sums (for checkpoints).
+    pub fn sums(&self) -> [f64; 5] {
+        [self.n, self.sx, self.sy, self.sxx, self.sxy]
+    }
+
+    pub fn from_sums(s: [f64; 5]) -> CubeCost {
+        CubeCost {
+            n: s[0],
+            sx: s[1],
+            sy: s[2],
+            sxx: s[3],
+            sxy: s[4],
+        }
+    }
+
     pub fn add(&mut self, cells: usize, seconds: f64) {
         let x = cells as f64;
         self.n += 1.0;

@@ -26,7 +26,7 @@
 use super::scalar;
 
 /// The paper's two metrics and the RMS relative error, as fractions (0.01 = 1 %).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ErrorMetrics {
     /// Average energy error Σ|Φ − Φref| / ΣΦref.
     pub energy: f64,

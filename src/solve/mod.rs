@@ -7,6 +7,7 @@
 //! ΔΦ_i / X and the patch it hits first gains ρ_j·ΔΦ_i/X (so ΔB_j += ρ_j·ΔΦ_i·F_ij/A_j with
 //! F_ij estimated by the fraction of rays).
 
+pub mod checkpoint;
 pub mod cube_shots;
 pub mod error;
 pub mod gathering;
@@ -92,6 +93,13 @@ pub struct SolveConfig {
     /// Keep one channel per light group (`--per-light`): the solution then carries each
     /// light's own radiosity, for relighting without solving again.
     pub light_groups: Option<std::sync::Arc<lights::LightGroups>>,
+    /// Write a checkpoint at the first safe point every so often, and on interrupt
+    /// (`--checkpoint`), through this sink.
+    pub checkpoint: Option<checkpoint::Sink>,
+    /// Continue from this checkpoint (`--resume`).
+    pub resume: Option<std::sync::Arc<checkpoint::Snapshot>>,
+    /// Set (by a Ctrl-C handler) to stop at the next safe point.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl Default for SolveConfig {
@@ -110,12 +118,15 @@ impl Default for SolveConfig {
             switch_at: None,
             reference: None,
             light_groups: None,
+            checkpoint: None,
+            resume: None,
+            interrupt: None,
         }
     }
 }
 
 /// Why the solve stopped.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StopReason {
     /// Sec. 3: max unshot radiosity fell below the requested fraction of the mean radiosity.
@@ -124,10 +135,12 @@ pub enum StopReason {
     Exhausted,
     MaxTime,
     MaxRays,
+    /// Ctrl-C: stopped at the next safe point (after writing a checkpoint, if asked).
+    Interrupted,
 }
 
 /// One point of the convergence trace.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct TracePoint {
     pub time_s: f64,
     pub shots: u64,
@@ -148,7 +161,7 @@ pub struct TracePoint {
 
 /// Where the emitted energy went (W per RGB channel). emitted = absorbed + absorbed_back +
 /// escaped + unshot, to rounding.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct EnergyBalance {
     pub emitted: [f64; 3],
     /// Absorbed by front faces: (1 − ρ) of what they received.
@@ -203,7 +216,7 @@ pub struct SolveStats {
 }
 
 /// The hemi-cube → rays switch of `adaptive-hybrid` (Sec. 4), with the costs it compared.
-#[derive(Clone, Copy, Debug, Default, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SwitchInfo {
     /// The first shot cast by rays.
     pub shot: u64,
@@ -258,6 +271,8 @@ pub enum SolveError {
     GatherTooLarge(#[from] gathering::TooLarge),
     #[error("the reference has {reference} patches but this mesh has {patches}: solve the reference with the same scene and --patch-size")]
     ReferenceMismatch { reference: usize, patches: usize },
+    #[error("{0}")]
+    Checkpoint(String),
     #[error("--method {0} casts rays but no intersector was built")]
     NoIntersector(&'static str),
 }

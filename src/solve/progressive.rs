@@ -15,6 +15,7 @@
 //! composition does not depend on the thread count, so results are identical on any number of
 //! threads.
 
+use super::checkpoint::{Header, SYNC_WAVES};
 use super::cube_shots::{self, CubeCost, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WAVE};
 use super::error::Estimator;
 use super::state::{rng_for, State};
@@ -382,14 +383,86 @@ pub fn shoot<I: Intersector>(
         energy_per_ray: c_ray,
         ..SolveStats::default()
     };
+    // Resuming: the books, the counters and the trace so far (see `checkpoint`).
+    let mut time_offset = 0.0;
+    if let Some(snap) = &cfg.resume {
+        let h = &snap.header;
+        if (h.energy_per_ray - c_ray).abs() > 1e-12 * c_ray {
+            return Err(SolveError::Checkpoint(format!(
+                "the checkpoint's energy per ray is {} W, this run's {c_ray} W: resume with the same --tolerance or --energy-per-ray",
+                h.energy_per_ray
+            )));
+        }
+        st.restore(snap).map_err(SolveError::Checkpoint)?;
+        stats.shots = h.shots;
+        stats.waves = h.waves;
+        stats.hemicube_shots = h.hemicube_shots;
+        stats.hemicube_cells = h.hemicube_cells;
+        stats.switch = h.switch;
+        stats.trace = h.trace.clone();
+        if !h.cubes_active {
+            cubes = None;
+        }
+        cube_cost = CubeCost::from_sums(h.cube_cost);
+        ray_cost = h.ray_cost;
+        time_offset = h.elapsed;
+    }
     let mut pending: Option<Pending> = None;
-    let mut next_trace = 0.0f64;
-    let mut next_trace_shots = 0u64;
+    let mut next_trace = time_offset;
+    let mut next_trace_shots = stats.shots;
+    let mut last_sync: Option<u64> = None;
+    let mut next_checkpoint = time_offset;
     let stop_reason = loop {
+        let elapsed = time_offset + start.elapsed().as_secs_f64();
+        // A safe point every SYNC_WAVES waves, whether or not anyone checkpoints (so runs
+        // with and without checkpoints, and resumed runs, shoot the same): the wave in flight
+        // lands, then a checkpoint is written if one is due or Ctrl-C was pressed.
+        if stats.waves.is_multiple_of(SYNC_WAVES) && last_sync != Some(stats.waves) {
+            last_sync = Some(stats.waves);
+            if let Some(p) = pending.take() {
+                apply_rays(&mut st, &p.wave, &p.tasks, &p.hits);
+            }
+            let interrupted = cfg
+                .interrupt
+                .as_ref()
+                .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
+            if let Some(sink) = &cfg.checkpoint {
+                if interrupted || elapsed >= next_checkpoint {
+                    let snap = st.snapshot(Header {
+                        elapsed,
+                        shots: stats.shots,
+                        waves: stats.waves,
+                        hemicube_shots: stats.hemicube_shots,
+                        hemicube_cells: stats.hemicube_cells,
+                        energy_per_ray: c_ray,
+                        switch: stats.switch,
+                        cubes_active: cubes.is_some(),
+                        cube_cost: cube_cost.sums(),
+                        ray_cost,
+                        trace: stats.trace.clone(),
+                        ..Header::default()
+                    });
+                    (sink.write)(&snap).map_err(SolveError::Checkpoint)?;
+                    next_checkpoint = elapsed + sink.every.as_secs_f64();
+                }
+            }
+            if interrupted {
+                let max_b = st.max_unshot_b();
+                st.record(
+                    &mut stats,
+                    elapsed,
+                    max_b,
+                    &est,
+                    reference,
+                    0.0,
+                    &mut on_trace,
+                );
+                break StopReason::Interrupted;
+            }
+        }
         // Sec. 3's criterion, then the budgets.
         let max_b = st.max_unshot_b();
         let mean_b = st.mean_b();
-        let elapsed = start.elapsed().as_secs_f64();
         let in_flight = pending
             .as_ref()
             .map_or(0, |p| p.hits.iter().map(Vec::len).sum::<usize>())
@@ -563,7 +636,7 @@ pub fn shoot<I: Intersector>(
     stats.hemicube_cells = st.cells;
     stats.energy = st.energy;
     stats.stop_reason = Some(stop_reason);
-    stats.seconds = start.elapsed().as_secs_f64();
+    stats.seconds = time_offset + start.elapsed().as_secs_f64();
     let channels = match &cfg.light_groups {
         Some(g) => st
             .channel_radiosity(mesh, materials, &g.of_patch)

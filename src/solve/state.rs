@@ -405,6 +405,85 @@ impl State {
         self.energy.unshot = unshot;
     }
 
+    /// The books, for a checkpoint (the header's counters are filled by the caller).
+    pub fn snapshot(&self, header: super::checkpoint::Header) -> super::checkpoint::Snapshot {
+        let (ch_unshot, ch_gathered, k) = match &self.channels {
+            Some(c) => (c.unshot.clone(), c.gathered.clone(), c.k),
+            None => (Vec::new(), Vec::new(), 0),
+        };
+        super::checkpoint::Snapshot {
+            header: super::checkpoint::Header {
+                patches: self.patches.len(),
+                energy: self.energy,
+                b_flux: self.b_flux,
+                rays: self.rays,
+                cells: self.cells,
+                shot_flux: self.shot_flux,
+                cube_len: self.cube_gathered.len(),
+                channels: k,
+                ..header
+            },
+            unshot: self.patches.iter().map(|p| p.unshot).collect(),
+            gathered: self.patches.iter().map(|p| p.gathered).collect(),
+            cube_gathered: self.cube_gathered.clone(),
+            cube_var: self.cube_var.clone(),
+            ch_unshot,
+            ch_gathered,
+        }
+    }
+
+    /// Puts a checkpoint's books back (onto a state built for the same mesh and settings) and
+    /// rebuilds the queues from them.
+    pub fn restore(&mut self, s: &super::checkpoint::Snapshot) -> Result<(), String> {
+        let h = &s.header;
+        let n = self.patches.len();
+        if h.patches != n || s.unshot.len() != n || s.gathered.len() != n {
+            return Err(format!(
+                "the checkpoint has {} patches, this mesh {n}",
+                h.patches
+            ));
+        }
+        let k = self.channels.as_ref().map_or(0, |c| c.k);
+        if h.channels != k {
+            return Err(format!(
+                "the checkpoint has {} light channels, this run {k} (--per-light must match)",
+                h.channels
+            ));
+        }
+        for (p, (u, g)) in self
+            .patches
+            .iter_mut()
+            .zip(s.unshot.iter().zip(&s.gathered))
+        {
+            p.unshot = *u;
+            p.gathered = *g;
+        }
+        self.energy = h.energy;
+        self.b_flux = h.b_flux;
+        self.rays = h.rays;
+        self.cells = h.cells;
+        self.shot_flux = h.shot_flux;
+        self.cube_gathered = s.cube_gathered.clone();
+        self.cube_var = s.cube_var.clone();
+        if let Some(c) = &mut self.channels {
+            c.unshot = s.ch_unshot.clone();
+            c.gathered = s.ch_gathered.clone();
+        }
+        // The queues hold one current entry per patch with unshot light (the ones below the
+        // max-ΔB heap's pruning threshold left out, as the running solve does).
+        self.by_flux = LazyHeap::default();
+        self.by_b = LazyHeap::default();
+        let threshold = self.stop_fraction * self.mean_b() * (1.0 - self.rho_max);
+        for j in 0..n {
+            let (kf, kb) = (self.key_flux(j), self.key_b(j));
+            self.by_flux.push(kf, j);
+            if kb >= threshold {
+                self.by_b.push(kb, j);
+            }
+        }
+        Ok(())
+    }
+
     /// Adds a trace point (and tells the caller): the solver's own error estimate always, the
     /// error against `reference` when there is one. The heap knows the max only above the stop
     /// threshold; a trace point is rare enough to scan for the exact value.

@@ -1,0 +1,263 @@
+//! Checkpoints (issue 8): a solve resumed from a checkpoint ends exactly where the
+//! uninterrupted one does, for the same seed; Ctrl-C (the interrupt flag) stops at a safe
+//! point with a checkpoint; corrupt, truncated or foreign checkpoints are refused.
+
+use assert_cmd::Command;
+use radiosity::intersect::embree::EmbreeScene;
+use radiosity::mesh::{self, Mesh, MeshOptions};
+use radiosity::scene::{self, LoadOptions, Scene};
+use radiosity::solve::checkpoint::{Sink, Snapshot};
+use radiosity::solve::{self, MethodKind, Solution, SolveConfig, StopReason};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+fn office() -> (Scene, Mesh) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/office.obj");
+    let s = scene::load_obj(&path, &LoadOptions::default()).unwrap();
+    let m = mesh::build(
+        &s,
+        &MeshOptions {
+            patch_size: Some(0.6),
+            two_sided: false,
+        },
+    );
+    (s, m)
+}
+
+fn run(s: &Scene, m: &Mesh, cfg: &SolveConfig) -> Solution {
+    let isect = EmbreeScene::build(m, |_| true).unwrap();
+    solve::solve(m, &s.materials, &isect, cfg, |_| {}).unwrap()
+}
+
+/// Every safe point's snapshot, kept in memory.
+fn recording_sink() -> (Sink, Arc<Mutex<Vec<Snapshot>>>) {
+    let kept = Arc::new(Mutex::new(Vec::new()));
+    let k = kept.clone();
+    let sink = Sink {
+        every: Duration::ZERO,
+        write: Arc::new(move |s: &Snapshot| {
+            k.lock().unwrap().push(s.clone());
+            Ok(())
+        }),
+    };
+    (sink, kept)
+}
+
+#[test]
+fn resumed_runs_equal_uninterrupted_ones() {
+    let (s, m) = office();
+    for (method, switch_at) in [
+        (MethodKind::AdaptiveRays, None),
+        (MethodKind::AdaptiveHemicube, None),
+        (MethodKind::AdaptiveHybrid, Some(12)),
+    ] {
+        let base = SolveConfig {
+            method,
+            switch_at,
+            tolerance: 0.03,
+            ..SolveConfig::default()
+        };
+        let plain = run(&s, &m, &base);
+        let (sink, kept) = recording_sink();
+        let with = run(
+            &s,
+            &m,
+            &SolveConfig {
+                checkpoint: Some(sink),
+                ..base.clone()
+            },
+        );
+        // Checkpointing does not change the run.
+        assert_eq!(with.b, plain.b, "{}", method.name());
+        let snaps = kept.lock().unwrap().clone();
+        assert!(
+            snaps.len() >= 3,
+            "{}: {} safe points",
+            method.name(),
+            snaps.len()
+        );
+        // Resume from a safe point in the middle, through the file format.
+        let mid = &snaps[snaps.len() / 2];
+        let snap = Snapshot::from_bytes("mid", &mid.to_bytes()).unwrap();
+        assert!(snap.header.shots > 0);
+        let resumed = run(
+            &s,
+            &m,
+            &SolveConfig {
+                resume: Some(Arc::new(snap)),
+                ..base.clone()
+            },
+        );
+        assert_eq!(resumed.b, plain.b, "{}", method.name());
+        assert_eq!(resumed.stats.shots, plain.stats.shots);
+        assert_eq!(resumed.stats.rays, plain.stats.rays);
+    }
+}
+
+#[test]
+fn an_interrupt_stops_at_a_safe_point_with_a_checkpoint() {
+    let (s, m) = office();
+    let base = SolveConfig {
+        method: MethodKind::AdaptiveRays,
+        tolerance: 0.03,
+        ..SolveConfig::default()
+    };
+    let plain = run(&s, &m, &base);
+    let flag = Arc::new(AtomicBool::new(false));
+    let kept = Arc::new(Mutex::new(Vec::new()));
+    let (k, f) = (kept.clone(), flag.clone());
+    let sink = Sink {
+        every: Duration::ZERO,
+        write: Arc::new(move |snap: &Snapshot| {
+            let mut v = k.lock().unwrap();
+            v.push(snap.clone());
+            // "Ctrl-C" after the third safe point.
+            if v.len() == 3 {
+                f.store(true, Ordering::SeqCst);
+            }
+            Ok(())
+        }),
+    };
+    let stopped = run(
+        &s,
+        &m,
+        &SolveConfig {
+            checkpoint: Some(sink),
+            interrupt: Some(flag),
+            ..base.clone()
+        },
+    );
+    assert_eq!(stopped.stats.stop_reason, Some(StopReason::Interrupted));
+    assert!(stopped.stats.energy.relative_residual() < 1e-9);
+    let last = kept.lock().unwrap().last().unwrap().clone();
+    let resumed = run(
+        &s,
+        &m,
+        &SolveConfig {
+            resume: Some(Arc::new(last)),
+            ..base
+        },
+    );
+    assert_eq!(resumed.b, plain.b);
+}
+
+fn cli(args: &[&str]) -> (i32, String) {
+    let out = Command::cargo_bin("radiosity")
+        .unwrap()
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn command_line_checkpoints_and_refusals() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).display().to_string();
+    let blocks = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/blocks.obj");
+    let blocks = blocks.to_str().unwrap();
+    let (code, err) = cli(&[
+        "solve",
+        blocks,
+        "--method",
+        "adaptive-rays",
+        "--checkpoint",
+        &p("c.ckpt"),
+        "--out",
+        &p("a"),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let bytes = std::fs::read(p("c.ckpt")).unwrap();
+    // Resuming the finished run's checkpoint finishes at once, with the same table.
+    let (code, err) = cli(&[
+        "solve",
+        blocks,
+        "--method",
+        "adaptive-rays",
+        "--resume",
+        &p("c.ckpt"),
+        "--out",
+        &p("b"),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    // Another seed, another scene, a truncated or a foreign file: refused, exit 2.
+    let refuse = |args: &[&str], needle: &str| {
+        let (code, err) = cli(args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: '{needle}' not in {err}");
+        assert!(!err.contains("panicked"));
+    };
+    refuse(
+        &[
+            "solve",
+            blocks,
+            "--method",
+            "adaptive-rays",
+            "--seed",
+            "9",
+            "--resume",
+            &p("c.ckpt"),
+            "--out",
+            &p("c"),
+        ],
+        "another run",
+    );
+    refuse(
+        &[
+            "solve",
+            "--method",
+            "adaptive-rays",
+            "--resume",
+            &p("c.ckpt"),
+            "--out",
+            &p("d"),
+        ],
+        "another run",
+    );
+    std::fs::write(p("short.ckpt"), &bytes[..bytes.len() / 2]).unwrap();
+    refuse(
+        &[
+            "solve",
+            blocks,
+            "--method",
+            "adaptive-rays",
+            "--resume",
+            &p("short.ckpt"),
+            "--out",
+            &p("e"),
+        ],
+        "truncated",
+    );
+    std::fs::write(p("junk.ckpt"), b"this is not a checkpoint at all").unwrap();
+    refuse(
+        &[
+            "solve",
+            blocks,
+            "--resume",
+            &p("junk.ckpt"),
+            "--out",
+            &p("f"),
+        ],
+        "not a radiosity checkpoint",
+    );
+    refuse(
+        &[
+            "solve",
+            blocks,
+            "--method",
+            "gathering",
+            "--checkpoint",
+            &p("g.ckpt"),
+            "--out",
+            &p("g"),
+        ],
+        "gathering",
+    );
+}
