@@ -15,7 +15,7 @@ use crate::Error;
 use plotters::prelude::*;
 use std::sync::Once;
 
-const SIZE: (u32, u32) = (720, 460);
+const SIZE: (u32, u32) = (680, 430);
 const FONT: &str = "sans-serif";
 
 const COLOURS: [RGBColor; 8] = [
@@ -142,10 +142,15 @@ fn draw(
     }
     let img = image::RgbImage::from_raw(w, h, buf)
         .ok_or_else(|| Error::Plot("the plot buffer has the wrong size".into()))?;
-    let mut png = std::io::Cursor::new(Vec::new());
-    img.write_to(&mut png, image::ImageFormat::Png)
-        .map_err(plot_error)?;
-    Ok(png.into_inner())
+    // Plots are committed to the repository (docs/compare): the best compression.
+    let mut png = Vec::new();
+    let encoder = image::codecs::png::PngEncoder::new_with_quality(
+        &mut png,
+        image::codecs::png::CompressionType::Best,
+        image::codecs::png::FilterType::Adaptive,
+    );
+    img.write_with_encoder(encoder).map_err(plot_error)?;
+    Ok(png)
 }
 
 fn shooters(cmp: &Comparison) -> impl Iterator<Item = &MethodRun> {
