@@ -30,13 +30,16 @@ pub enum Error {
     /// A check ran and its bar failed (`radiosity crosscheck`): exit code 1.
     #[error("{0}")]
     Failed(String),
+    /// A plot could not be drawn (`radiosity compare`): exit code 1.
+    #[error("cannot draw a plot: {0}")]
+    Plot(String),
 }
 
 impl Error {
     /// 2 for what the user can fix (input, flags, output folder), 1 for internal failures.
     pub fn exit_code(&self) -> u8 {
         match self {
-            Error::Embree(_) | Error::Failed(_) => 1,
+            Error::Embree(_) | Error::Failed(_) | Error::Plot(_) => 1,
             _ => 2,
         }
     }

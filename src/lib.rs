@@ -10,6 +10,7 @@
 //! solution on. The `radiosity` binary is a thin layer over this library.
 #![deny(unsafe_code)]
 
+pub mod compare;
 pub mod error;
 pub mod export;
 pub mod false_colour;

@@ -3,6 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
+use radiosity::compare::{self, CompareJob, ReferenceJob};
 use radiosity::intersect::select::IntersectorKind;
 use radiosity::intersect_jobs::{self, CrossJob};
 use radiosity::mesh::MeshOptions;
@@ -45,6 +46,13 @@ enum Command {
     /// Cast the same rays through every intersector the scene supports and compare the hit
     /// patches against the reference (exit code 1 if the bar fails).
     Crosscheck(CrosscheckArgs),
+    /// Solve a high-accuracy reference (adaptive rays, two independent halves averaged) and
+    /// write DIR/patches.csv and DIR/summary.json with its stated error bound, checked against
+    /// the difference of the halves (exit code 1 if they disagree by more than 2×).
+    Reference(ReferenceArgs),
+    /// Run methods side by side against one reference and write compare.csv, compare.md,
+    /// compare.json and the plots (error against time, Fig. 2's decay, Fig. 5's cost per shot).
+    Compare(CompareArgs),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -187,6 +195,87 @@ enum GenerateCommand {
         #[arg(long, default_value_t = 1)]
         seed: u64,
     },
+}
+
+#[derive(Args)]
+struct ReferenceArgs {
+    /// OBJ file (with its MTL beside it); the built-in Cornell box if left out.
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    scene_args: SceneArgs,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Relative sampling error wanted (solve's default is 0.05: 100× fewer rays).
+    #[arg(long, default_value_t = 0.005, allow_negative_numbers = true)]
+    tolerance: f64,
+    /// Stop when the max unshot radiosity is below this fraction of the mean radiosity.
+    #[arg(
+        long,
+        default_value_t = 1e-5,
+        value_name = "FRACTION",
+        allow_negative_numbers = true
+    )]
+    stop: f64,
+    #[arg(long, value_enum, default_value_t = IntersectorArg::Auto)]
+    intersector: IntersectorArg,
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    /// OBJ file (with its MTL beside it); the built-in Cornell box if left out.
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    scene_args: SceneArgs,
+    /// Methods to run, in order; speedups are of the first over each other.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "adaptive-hybrid,adaptive-rays,adaptive-hemicube,hemicube,hemicube-jittered,gathering"
+    )]
+    methods: Vec<Method>,
+    /// Time budget per method in seconds (gathering always finishes its matrix).
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    budget: f64,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// A reference patch table of the same scene and patch size (default: build one, as
+    /// `radiosity reference` does, and write it to OUT/reference/patches.csv).
+    #[arg(long, value_name = "PATCHES.csv")]
+    reference: Option<PathBuf>,
+    /// Tolerance of the reference built here.
+    #[arg(long, default_value_t = 0.005, allow_negative_numbers = true)]
+    reference_tolerance: f64,
+    /// Stop fraction of the reference built here.
+    #[arg(long, default_value_t = 1e-5, allow_negative_numbers = true)]
+    reference_stop: f64,
+    /// Error levels (fractions: 0.05 = 5 %) of the time-to-error table.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "0.2,0.1,0.05,0.03,0.02,0.01",
+        allow_negative_numbers = true
+    )]
+    levels: Vec<f64>,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Relative sampling error of the compared runs (sets the rays' energy, as in solve).
+    #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
+    tolerance: f64,
+    /// Stop fraction of the compared runs (paper Sec. 3: 0.06 %).
+    #[arg(long, default_value_t = 0.0006, allow_negative_numbers = true)]
+    stop: f64,
+    /// Resolution N of the uniform N×N hemi-cube (hemicube, hemicube-jittered, gathering).
+    #[arg(long, default_value_t = 100, value_name = "N")]
+    hemicube_n: usize,
+    #[arg(long, default_value_t = 4096, value_name = "MIB")]
+    gather_cap_mib: u64,
+    #[arg(long, value_enum, default_value_t = IntersectorArg::Auto)]
+    intersector: IntersectorArg,
 }
 
 #[derive(Args)]
@@ -789,6 +878,59 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
             Ok(())
         }
         Command::Crosscheck(a) => crosscheck(a),
+        Command::Reference(a) => {
+            let job = ReferenceJob {
+                source: source(a.scene),
+                load: a.scene_args.load(),
+                mesh: a.scene_args.mesh(),
+                solve: SolveConfig {
+                    seed: a.seed,
+                    tolerance: a.tolerance,
+                    stop_fraction: a.stop,
+                    ..SolveConfig::default()
+                },
+                intersector: a.intersector.into(),
+                out: a.out,
+            };
+            compare::run_reference(&job, |line| eprintln!("{line}")).map(|_| ())
+        }
+        Command::Compare(a) => {
+            if !(a.budget > 0.0 && a.budget.is_finite() && a.budget < 1e7) {
+                return Err(radiosity::Error::Invalid(format!(
+                    "--budget must be a positive number of seconds, got {}",
+                    a.budget
+                )));
+            }
+            let job = CompareJob {
+                source: source(a.scene),
+                load: a.scene_args.load(),
+                mesh: a.scene_args.mesh(),
+                methods: a.methods.into_iter().map(MethodKind::from).collect(),
+                budget: Duration::from_secs_f64(a.budget),
+                solve: SolveConfig {
+                    seed: a.seed,
+                    tolerance: a.tolerance,
+                    stop_fraction: a.stop,
+                    hemicube_n: a.hemicube_n,
+                    gather_cap_mib: a.gather_cap_mib,
+                    ..SolveConfig::default()
+                },
+                reference: a.reference,
+                reference_solve: SolveConfig {
+                    seed: a.seed.wrapping_add(1_000_003),
+                    tolerance: a.reference_tolerance,
+                    stop_fraction: a.reference_stop,
+                    ..SolveConfig::default()
+                },
+                intersector: a.intersector.into(),
+                levels: a.levels,
+                out: a.out.clone(),
+            };
+            let cmp = compare::run_compare(&job, |line| eprintln!("{line}"))?;
+            print!("{}", compare::report::markdown(&cmp));
+            eprintln!("outputs in {}", a.out.display());
+            Ok(())
+        }
         Command::Bench(BenchCommand::Intersect {
             scenes,
             scene_args,

@@ -14,24 +14,29 @@ pub const HEADER: &str = "time_s,shots,rays,cells,max_unshot_b,mean_b,unshot_flu
 pub fn write(w: &mut dyn Write, trace: &[TracePoint]) -> io::Result<()> {
     writeln!(w, "{HEADER}")?;
     for p in trace {
-        write!(
-            w,
-            "{},{},{},{},{},{},{},{},{},{}",
-            p.time_s,
-            p.shots,
-            p.rays,
-            p.cells,
-            p.max_unshot_b,
-            p.mean_b,
-            p.unshot_flux,
-            p.estimate.energy,
-            p.estimate.weighted_percent,
-            p.estimate.rms_relative
-        )?;
-        match &p.error {
-            Some(e) => writeln!(w, ",{},{},{}", e.energy, e.weighted_percent, e.rms_relative)?,
-            None => writeln!(w, ",,,")?,
-        }
+        write_row(w, p)?;
     }
     Ok(())
+}
+
+/// Writes one trace point as a row of [`HEADER`]'s columns.
+pub fn write_row(w: &mut dyn Write, p: &TracePoint) -> io::Result<()> {
+    write!(
+        w,
+        "{},{},{},{},{},{},{},{},{},{}",
+        p.time_s,
+        p.shots,
+        p.rays,
+        p.cells,
+        p.max_unshot_b,
+        p.mean_b,
+        p.unshot_flux,
+        p.estimate.energy,
+        p.estimate.weighted_percent,
+        p.estimate.rms_relative
+    )?;
+    match &p.error {
+        Some(e) => writeln!(w, ",{},{},{}", e.energy, e.weighted_percent, e.rms_relative),
+        None => writeln!(w, ",,,"),
+    }
 }
