@@ -28,5 +28,6 @@ pub mod sample;
 pub mod scene;
 pub mod shot_bench;
 pub mod solve;
+pub mod sweep;
 
 pub use error::Error;

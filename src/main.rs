@@ -53,6 +53,10 @@ enum Command {
     /// Run methods side by side against one reference and write compare.csv, compare.md,
     /// compare.json and the plots (error against time, Fig. 2's decay, Fig. 5's cost per shot).
     Compare(CompareArgs),
+    /// The scene-size performance sweep over generated buildings: times, rays per second,
+    /// peak memory and the solver's error estimate per size and method; CSV, Markdown with
+    /// growth exponents, log-log plots.
+    Sweep(SweepArgs),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -467,6 +471,29 @@ enum RaysArg {
     Both,
     Surface,
     Uniform,
+}
+
+#[derive(Args)]
+struct SweepArgs {
+    /// Building sizes in patches (1k = 1000, 1M = 1000000).
+    #[arg(long, value_parser = parse_sizes, default_value = "1k,4k,16k,64k,256k,1M")]
+    sizes: Sizes,
+    /// Methods to run at every size.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "adaptive-hybrid"
+    )]
+    methods: Vec<Method>,
+    #[command(flatten)]
+    solve_args: SolverArgs,
+    /// Output folder (sweep.csv, sweep.md, time.png, memory.png).
+    #[arg(long)]
+    out: PathBuf,
+    /// Seed of the generated buildings.
+    #[arg(long, default_value_t = 1)]
+    building_seed: u64,
 }
 
 /// A list of patch counts.
@@ -893,6 +920,23 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 out: a.out,
             };
             compare::run_reference(&job, |line| eprintln!("{line}")).map(|_| ())
+        }
+        Command::Sweep(a) => {
+            if a.sizes.0.is_empty() {
+                return Err(radiosity::Error::Invalid("--sizes names no size".into()));
+            }
+            let job = radiosity::sweep::SweepJob {
+                sizes: a.sizes.0.clone(),
+                methods: a.methods.iter().copied().map(MethodKind::from).collect(),
+                cfg: a.solve_args.config()?,
+                intersector: a.solve_args.intersector.into(),
+                out: a.out.clone(),
+                seed: a.building_seed,
+            };
+            let rows = radiosity::sweep::run(&job, |l| println!("{l}"))?;
+            println!("{}", radiosity::sweep::markdown(&rows, &job.methods));
+            println!("outputs in {}", a.out.display());
+            Ok(())
         }
         Command::Compare(a) => {
             if !(a.budget > 0.0 && a.budget.is_finite() && a.budget < 1e7) {

@@ -63,13 +63,13 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 }
 
 /// One curve per method.
-struct Curve {
-    label: String,
-    points: Vec<(f64, f64)>,
+pub(crate) struct Curve {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
 }
 
 /// Draws curves on a chart with a log y axis (and a log x axis if `log_x`) into PNG bytes.
-fn draw(
+pub(crate) fn draw(
     title: &str,
     x_desc: &str,
     y_desc: &str,
