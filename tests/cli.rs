@@ -450,3 +450,29 @@ fn bench_intersect_writes_a_table_and_csv() {
         &["--generated"],
     );
 }
+
+/// A small sweep keeps the command working (full sizes are run by hand; README).
+#[test]
+fn a_small_sweep_writes_its_table_and_plots() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sweep");
+    let (code, stdout, err) = run(&[
+        "sweep",
+        "--sizes",
+        "1k,2k",
+        "--tolerance",
+        "0.2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("Growth exponents"), "{stdout}");
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    assert!(!csv.contains("NaN"));
+    for png in ["time.png", "memory.png"] {
+        let img = image::open(out.join(png)).unwrap();
+        assert!(img.width() > 100);
+    }
+    assert_user_error(&["sweep", "--sizes", "0", "--out", "x"], &["--sizes"]);
+}
