@@ -169,7 +169,7 @@ impl<I: Intersector> Ctx<'_, I> {
             index: u64::MAX - 1,
             phi: [0.0; 3],
             ch: Vec::new(),
-            grid: PolarGrid::for_samples((4 * CHUNK) as f64),
+            grid: PolarGrid::for_samples((2 * CHUNK) as f64),
         };
         let tasks = tasks_of(std::slice::from_ref(&shot));
         let mut per_ray = 0.0;
