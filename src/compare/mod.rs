@@ -2,7 +2,7 @@
 //! the paper's error analysis (Sec. 3, Table 1) and speed analysis (Sec. 4, Figs. 2 and 5)
 //! measured in one process, on one scene, mesh and machine.
 //!
-//! - [`reference`]: the high-accuracy reference, its stated error bound and the check of it;
+//! - [`reference`](mod@reference): the high-accuracy reference, its stated error bound and the check of it;
 //! - [`analysis`]: time to reach an error level, the decay constant E, cost per shot;
 //! - [`report`]: `compare.csv` and `compare.md`; [`plot`]: the PNG plots.
 

@@ -4,7 +4,7 @@
 //! tried and dropped: it polls `rtcGetDeviceError` after every ray, hides the scene handle that
 //! `rtcIntersect1` needs, and — measured here — its `intersect_1` is unsound against Embree
 //! 4.3+: the library writes `instPrimID` (4 bytes, seen as 0xffffffff) past the end of the
-//! `RTCRayHit` laid out from the 4.2 headers, i.e. past its stack variable. [`RayHitSlack`]
+//! `RTCRayHit` laid out from the 4.2 headers, i.e. past its stack variable. `RayHitSlack`
 //! gives that write somewhere to land. Its `Device` cannot be used on its own either: the
 //! handle is crate-private (so no scene of ours can be made on it), the type is `!Send`, and
 //! `Device::try_new` hands `rtcNewDevice` a Rust `&str` that is not NUL-terminated. Patches are fanned into triangles; `prim_patch` maps Embree's primitive ids back.
