@@ -42,7 +42,16 @@ pub fn write_atomic(
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
-    result.map_err(err)
+    result.map_err(|e| err(file_in_the_way(path).unwrap_or(e)))
+}
+
+/// A regular file where a folder of `path` should be, as an error that names it.
+fn file_in_the_way(path: &Path) -> Option<std::io::Error> {
+    let file = path.ancestors().skip(1).find(|a| a.is_file())?;
+    Some(std::io::Error::other(format!(
+        "{} is a file, not a folder",
+        file.display()
+    )))
 }
 
 /// Makes sure `dir` exists and is writable, before any work is spent on what goes into it.
@@ -53,11 +62,8 @@ pub fn prepare_dir(dir: &Path) -> Result<Vec<PathBuf>, WriteError> {
         source,
     };
     // A regular file where a folder should be: say so rather than "File exists".
-    if let Some(file) = dir.ancestors().find(|a| a.is_file()) {
-        return Err(err(std::io::Error::other(format!(
-            "{} is a file, not a folder",
-            file.display()
-        ))));
+    if let Some(e) = file_in_the_way(&dir.join("x")) {
+        return Err(err(e));
     }
     let made: Vec<PathBuf> = dir
         .ancestors()
