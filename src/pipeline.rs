@@ -112,6 +112,16 @@ pub fn load_scene(source: &SceneSource, opts: &LoadOptions) -> Result<Scene, Err
     })
 }
 
+/// Cuts the scene into patches, refusing a patch size that would make far too many.
+pub fn build_mesh(scene: &Scene, opts: &MeshOptions) -> Result<Mesh, Error> {
+    mesh::try_build(scene, opts).map_err(|message| {
+        Error::Scene(scene::SceneError {
+            path: scene.name.clone(),
+            message,
+        })
+    })
+}
+
 /// Checks settings a user can get wrong, before any work.
 pub fn validate(job: &SolveJob) -> Result<(), Error> {
     let s = &job.solve;
@@ -269,7 +279,7 @@ fn solve_into(
 
     let t = Instant::now();
     progress.phase("meshing");
-    let m = mesh::build(&scene, &job.mesh);
+    let m = build_mesh(&scene, &job.mesh)?;
     timings.mesh = t.elapsed().as_secs_f64();
     if job.mesh.patch_size.is_none() {
         let from = if scene.patch_size_hint.is_some() {
@@ -538,7 +548,7 @@ pub fn info(
     mesh_opts: &MeshOptions,
 ) -> Result<report::SceneInfo, Error> {
     let scene = load_scene(source, load)?;
-    let m = mesh::build(&scene, mesh_opts);
+    let m = build_mesh(&scene, mesh_opts)?;
     Ok(report::scene_info(
         &scene,
         &m,
@@ -626,7 +636,7 @@ pub fn bench_rays(
         ..cfg.clone()
     };
     let scene = load_scene(source, load)?;
-    let m = mesh::build(&scene, mesh_opts);
+    let m = build_mesh(&scene, mesh_opts)?;
     let (isect, chosen) = select::select(&m, kind)?;
     let (lo, hi) = scene.bounds();
     // Warm up (page in the BVH, spin up the threads). Then alternate raw measurements and
