@@ -44,6 +44,7 @@ const FILES: &[Case] = &[
     ("vertices but no face", "solve -q {c}/vertices-but-no-faces.obj --out {t}/o", &["vertices-but-no-faces.obj", "no polygons"]),
     ("polylines and points only", "solve -q {c}/lines-and-points-only.obj --out {t}/o", &["lines-and-points-only.obj", "no polygons"]),
     ("usemtl without a name", "solve -q {c}/usemtl-without-name.obj --out {t}/o", &["usemtl-without-name.obj", "line 5", "usemtl"]),
+    ("patch-size comment making 10^18 patches", "solve -q {c}/patch-size-hint-far-too-small.obj --out {t}/o", &["patch-size-hint-far-too-small.obj", "patches, over the limit", "--patch-size"]),
     ("bad patch-size comment", "solve -q {c}/bad-patch-size-hint.obj --out {t}/o", &["bad-patch-size-hint.obj", "line 1", "patch-size"]),
     // A missing MTL is only a warning (grey); the error is then that nothing emits.
     ("missing MTL, so no light", "solve -q {c}/missing-mtl-no-light.obj --out {t}/o", &["missing-mtl-no-light.obj", "no light", "--emit"]),
@@ -77,6 +78,8 @@ const FLAGS: &[Case] = &[
     ("--emit without =", "solve -q --out {t}/o --emit light", &["--emit", "MATERIAL=R,G,B"]),
     ("--patch-size 0", "solve -q --out {t}/o --patch-size 0", &["--patch-size", "positive length"]),
     ("--patch-size -1", "solve -q --out {t}/o --patch-size -1", &["--patch-size", "positive length"]),
+    ("--patch-size making 10^13 patches", "solve -q --out {t}/o --patch-size 1e-6", &["cornell-box", "patch size 0.000001 m", "over the limit"]),
+    ("info --patch-size making 10^13 patches", "info --patch-size 1e-6", &["cornell-box", "over the limit"]),
     ("--patch-size nan", "solve -q --out {t}/o --patch-size nan", &["--patch-size", "positive length"]),
     ("info --patch-size 0", "info --patch-size 0", &["--patch-size", "positive length"]),
     ("--tolerance 0", "solve -q --out {t}/o --tolerance 0", &["--tolerance", "(0, 1)"]),
