@@ -158,7 +158,7 @@ pub fn rough_patch_count(scene: &Scene, opts: &MeshOptions) -> f64 {
 /// would make more than [`MAX_PATCHES`] patches.
 pub fn try_build(scene: &Scene, opts: &MeshOptions) -> Result<Mesh, String> {
     let n = rough_patch_count(scene, opts);
-    if !(n <= MAX_PATCHES) {
+    if n.is_nan() || n > MAX_PATCHES {
         return Err(format!(
             "patch size {} m would make about {n:.1e} patches, over the limit of {MAX_PATCHES:.0e}: \
              use a larger --patch-size",
