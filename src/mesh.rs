@@ -691,6 +691,30 @@ mod tests {
     }
 
     #[test]
+    fn rough_patch_count_bounds_the_mesh_and_try_build_refuses_far_too_many() {
+        // A quad with one corner typed 800 m away (found by fuzzing: a mutated hallway): not
+        // convex, so ear-clipped into two slivers whose longest edge sets the subdivision.
+        let dart = [
+            vec3(0.9, 2.8, -18.9),
+            vec3(1.5, 2.8, -819.0),
+            vec3(1.5, 2.8, -17.1),
+            vec3(0.9, 2.8, -17.1),
+        ];
+        let square = [
+            vec3(0.0, 0.0, 0.0),
+            vec3(1.0, 0.0, 0.0),
+            vec3(1.0, 1.0, 0.0),
+            vec3(0.0, 1.0, 0.0),
+        ];
+        let scene = scene_of(&[&dart, &square]);
+        let m = build(&scene, &opts(5.0));
+        assert!(rough_patch_count(&scene, &opts(5.0)) >= m.patches.len() as f64);
+        let e = try_build(&scene, &opts(1e-3)).unwrap_err();
+        assert!(e.contains("over the limit") && !e.contains('\n'), "{e}");
+        assert_eq!(try_build(&scene, &opts(5.0)).unwrap(), m);
+    }
+
+    #[test]
     fn default_patch_size_is_a_nice_length() {
         assert_eq!(nice_length(0.0356), 0.04);
         assert_eq!(nice_length(0.6), 0.6);
