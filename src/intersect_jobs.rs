@@ -62,7 +62,7 @@ pub fn crosscheck(job: &CrossJob) -> Result<CrossCheck, Error> {
         )));
     }
     let scene = load_scene(&job.source, &job.load)?;
-    let m = mesh::build(&scene, &job.mesh);
+    let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
     if m.patches.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no patches to cast at",
@@ -143,7 +143,7 @@ pub fn bench_intersect(
     let mut rows = Vec::new();
     for source in &job.scenes {
         let scene = load_scene(source, &job.load)?;
-        let m = mesh::build(&scene, &job.mesh);
+        let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
         let row = bench::bench_mesh(&scene.name, &m, rays, seed, from)?;
         log(&row);
         rows.push(row);

@@ -25,7 +25,7 @@ struct Cli {
     #[command(subcommand)]
     command: Command,
     /// Worker threads (default: all cores). Results do not depend on it.
-    #[arg(long, global = true)]
+    #[arg(long, global = true, value_parser = parse_threads)]
     threads: Option<usize>,
 }
 
@@ -385,7 +385,7 @@ struct SceneArgs {
     #[arg(long, value_name = "MATERIAL=R,G,B", value_parser = parse_emit)]
     emit: Vec<(String, [f64; 3])>,
     /// Longest patch edge in metres (default: derived from the scene, and printed).
-    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true, value_parser = parse_length)]
     patch_size: Option<f32>,
     /// Give every polygon a back patch of its own (thin surfaces lit from both sides).
     #[arg(long)]
@@ -656,6 +656,40 @@ fn parse_floats<const N: usize>(s: &str) -> Result<[f64; N], String> {
         *o = v;
     }
     Ok(out)
+}
+
+fn parse_threads(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "'{s}' is not a thread count of at least 1 (leave --threads out for all cores)"
+        )),
+    }
+}
+
+/// A positive length in metres (`--patch-size`).
+fn parse_length(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("'{s}' is not a positive length in metres")),
+    }
+}
+
+/// A command-line error of clap's on one line: its message without the usage and help lines
+/// (help and version go to stdout as clap prints them).
+fn clap_error_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let mut parts = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if !line.is_empty() {
+            parts.push(line);
+        }
+    }
+    parts.join(" ")
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
@@ -1184,7 +1218,20 @@ fn interrupt_flag() -> std::sync::Arc<std::sync::atomic::AtomicBool> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e)
+            if !e.use_stderr()
+                || e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            let _ = e.print();
+            return ExitCode::from(e.exit_code() as u8);
+        }
+        Err(e) => {
+            eprintln!("{}", clap_error_line(&e));
+            return ExitCode::from(2);
+        }
+    };
     let threads = cli.threads.unwrap_or(0);
     if let Err(e) = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

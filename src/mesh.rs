@@ -126,13 +126,51 @@ pub fn newell(pts: &[Vec3]) -> Vec3 {
     n.as_vec3()
 }
 
-/// Builds the patches of `scene`.
-pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
-    let size = opts
-        .patch_size
+/// The most patches a mesh may have: a patch size that would make more is taken for a mistake
+/// (a typo in `--patch-size`, a wrong unit) rather than run out of memory.
+pub const MAX_PATCHES: f64 = 20e6;
+
+/// The patch size [`build`] uses: the option, else the scene's own, else derived.
+pub fn patch_size(scene: &Scene, opts: &MeshOptions) -> f32 {
+    opts.patch_size
         .or(scene.patch_size_hint)
         .filter(|s| s.is_finite() && *s > 0.0)
-        .unwrap_or_else(|| default_patch_size(scene));
+        .unwrap_or_else(|| default_patch_size(scene))
+}
+
+/// An upper estimate of how many patches [`build`] makes: per polygon, (its extent over the
+/// patch size)² cells for each of its n − 2 triangles. Cheap: no polygon is cut.
+pub fn rough_patch_count(scene: &Scene, opts: &MeshOptions) -> f64 {
+    let size = patch_size(scene, opts) as f64;
+    let sides = if opts.two_sided { 2.0 } else { 1.0 };
+    let per_polygon = |p: &crate::scene::Polygon| {
+        let pts = polygon_points(scene, p);
+        let (lo, hi) = pts
+            .iter()
+            .fold((pts[0], pts[0]), |(l, h), v| (l.min(*v), h.max(*v)));
+        let k = ((hi - lo).length() as f64 / size).ceil().max(1.0);
+        k * k * (pts.len().max(3) - 2) as f64
+    };
+    sides * scene.polygons.iter().map(per_polygon).sum::<f64>()
+}
+
+/// [`build`], refusing (one line, for a [`crate::scene::SceneError`]) a patch size that
+/// would make more than [`MAX_PATCHES`] patches.
+pub fn try_build(scene: &Scene, opts: &MeshOptions) -> Result<Mesh, String> {
+    let n = rough_patch_count(scene, opts);
+    if n.is_nan() || n > MAX_PATCHES {
+        return Err(format!(
+            "patch size {} m would make about {n:.1e} patches, over the limit of {MAX_PATCHES:.0e}: \
+             use a larger --patch-size",
+            patch_size(scene, opts)
+        ));
+    }
+    Ok(build(scene, opts))
+}
+
+/// Builds the patches of `scene`.
+pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
+    let size = patch_size(scene, opts);
     let (lo, hi) = scene.bounds();
     let mut b = Builder::new(size, (hi - lo).length().max(f32::MIN_POSITIVE));
     for (pi, poly) in scene.polygons.iter().enumerate() {
@@ -650,6 +688,30 @@ mod tests {
         let vals = m.vertex_values(&[[1.0; 3], [3.0; 3], [7.0; 3]]);
         let shared = m.patch_indices(1)[0] as usize; // (1,0,0) on floor_b
         assert_eq!(vals[shared], [2.0; 3]);
+    }
+
+    #[test]
+    fn rough_patch_count_bounds_the_mesh_and_try_build_refuses_far_too_many() {
+        // A quad with one corner typed 800 m away (found by fuzzing: a mutated hallway): not
+        // convex, so ear-clipped into two slivers whose longest edge sets the subdivision.
+        let dart = [
+            vec3(0.9, 2.8, -18.9),
+            vec3(1.5, 2.8, -819.0),
+            vec3(1.5, 2.8, -17.1),
+            vec3(0.9, 2.8, -17.1),
+        ];
+        let square = [
+            vec3(0.0, 0.0, 0.0),
+            vec3(1.0, 0.0, 0.0),
+            vec3(1.0, 1.0, 0.0),
+            vec3(0.0, 1.0, 0.0),
+        ];
+        let scene = scene_of(&[&dart, &square]);
+        let m = build(&scene, &opts(5.0));
+        assert!(rough_patch_count(&scene, &opts(5.0)) >= m.patches.len() as f64);
+        let e = try_build(&scene, &opts(1e-3)).unwrap_err();
+        assert!(e.contains("over the limit") && !e.contains('\n'), "{e}");
+        assert_eq!(try_build(&scene, &opts(5.0)).unwrap(), m);
     }
 
     #[test]

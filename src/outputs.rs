@@ -98,13 +98,7 @@ fn check_render_options(job: &RenderJob) -> Result<ImageKind, Error> {
             r.width, r.height
         )));
     }
-    if let Some(f) = job.camera.fov_y_deg {
-        if !(f > 0.0 && f < 180.0) {
-            return Err(Error::Invalid(format!(
-                "--fov must be in (0, 180) degrees, got {f}"
-            )));
-        }
-    }
+    job.camera.check().map_err(Error::Invalid)?;
     if let Some(e) = r.exposure {
         if !(e > 0.0 && e.is_finite()) {
             return Err(Error::Invalid(format!(

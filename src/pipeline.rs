@@ -36,6 +36,34 @@ pub struct CameraSpec {
 }
 
 impl CameraSpec {
+    /// Refuses a camera that cannot look anywhere: `--fov` outside (0, 180) degrees, `--eye`
+    /// on `--target`, a zero `--up` or one along the line of sight.
+    pub fn check(&self) -> Result<(), String> {
+        if let Some(f) = self.fov_y_deg {
+            if !(f > 0.0 && f < 180.0) {
+                return Err(format!("--fov must be in (0, 180) degrees, got {f}"));
+            }
+        }
+        if let (Some(eye), Some(target)) = (self.eye, self.target) {
+            if eye == target {
+                return Err(format!(
+                    "--eye and --target are the same point ({eye}): the camera looks nowhere"
+                ));
+            }
+            if let Some(up) = self.up {
+                if up.cross(target - eye).length_squared() == 0.0 && up != Vec3::ZERO {
+                    return Err(format!(
+                        "--up {up} is along the line of sight from --eye to --target"
+                    ));
+                }
+            }
+        }
+        if self.up == Some(Vec3::ZERO) {
+            return Err("--up must not be 0,0,0".into());
+        }
+        Ok(())
+    }
+
     /// The camera for a scene with bounds (lo, hi): fitted unless an eye is given.
     pub fn resolve(&self, lo: Vec3, hi: Vec3, aspect: f32) -> Camera {
         let mut cam = Camera::fit(lo, hi, aspect);
@@ -88,6 +116,16 @@ pub fn load_scene(source: &SceneSource, opts: &LoadOptions) -> Result<Scene, Err
     Ok(match source {
         SceneSource::Default => scene::default_scene(opts)?,
         SceneSource::File(p) => scene::load_obj(p, opts)?,
+    })
+}
+
+/// Cuts the scene into patches, refusing a patch size that would make far too many.
+pub fn build_mesh(scene: &Scene, opts: &MeshOptions) -> Result<Mesh, Error> {
+    mesh::try_build(scene, opts).map_err(|message| {
+        Error::Scene(scene::SceneError {
+            path: scene.name.clone(),
+            message,
+        })
     })
 }
 
@@ -146,12 +184,18 @@ pub fn validate(job: &SolveJob) -> Result<(), Error> {
             job.render.width, job.render.height
         )));
     }
-    if let Some(f) = job.camera.fov_y_deg {
-        if !(f > 0.0 && f < 180.0) {
+    job.camera.check().map_err(Error::Invalid)?;
+    if let Some(e) = job.render.exposure {
+        if !(e > 0.0 && e.is_finite()) {
             return Err(Error::Invalid(format!(
-                "--fov must be in (0, 180) degrees, got {f}"
+                "--exposure must be a positive number, got {e}"
             )));
         }
+    }
+    if s.max_rays == Some(0) {
+        return Err(Error::Invalid(
+            "--max-rays must be at least 1 (leave it out for no limit)".into(),
+        ));
     }
     Ok(())
 }
@@ -235,12 +279,33 @@ pub fn run_solve_with(
 ) -> Result<Summary, Error> {
     validate(job)?;
     let t0 = Instant::now();
-    let mut timings = Timings::default();
-    // Fail on an unwritable folder before spending any time.
-    export::prepare_dir(&job.out)?;
     if let Some(save) = &job.save {
         check_save_path(save)?;
     }
+    // Fail on an unwritable folder before spending any time.
+    let made = export::prepare_dir(&job.out)?;
+    // On failure leave nothing behind: not the files written so far, not the new folders.
+    let mut written = Vec::new();
+    let result = solve_into(job, progress, &mut log, t0, &mut written);
+    if result.is_err() {
+        for path in &written {
+            let _ = std::fs::remove_file(path);
+        }
+        export::remove_made_dirs(&made);
+    }
+    result
+}
+
+/// The work of [`run_solve_with`] once the output folder is ready; every file it writes is
+/// recorded in `written` as soon as it exists.
+fn solve_into(
+    job: &SolveJob,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+    t0: Instant,
+    written: &mut Vec<std::path::PathBuf>,
+) -> Result<Summary, Error> {
+    let mut timings = Timings::default();
 
     progress.phase("loading");
     let scene = load_scene(&job.source, &job.load)?;
@@ -251,7 +316,7 @@ pub fn run_solve_with(
 
     let t = Instant::now();
     progress.phase("meshing");
-    let m = mesh::build(&scene, &job.mesh);
+    let m = build_mesh(&scene, &job.mesh)?;
     timings.mesh = t.elapsed().as_secs_f64();
     if job.mesh.patch_size.is_none() {
         let from = if scene.patch_size_hint.is_some() {
@@ -350,9 +415,11 @@ pub fn run_solve_with(
     let mut outputs = Vec::new();
     let csv = job.out.join("patches.csv");
     write_atomic(&csv, |w| patches::write(w, &m, &scene.materials, &sol.b))?;
+    written.push(csv.clone());
     outputs.push(csv.display().to_string());
     let trace_csv = job.out.join("trace.csv");
     write_atomic(&trace_csv, |w| export::trace::write(w, &sol.stats.trace))?;
+    written.push(trace_csv.clone());
     outputs.push(trace_csv.display().to_string());
 
     let png = job.out.join("render.png");
@@ -367,10 +434,12 @@ pub fn run_solve_with(
             .map_err(std::io::Error::other)?;
         w.write_all(buf.get_ref())
     })?;
+    written.push(png.clone());
     outputs.push(png.display().to_string());
 
     if let Some(save) = &job.save {
         save_solution(save, job, &scene, &m, &sol)?;
+        written.push(save.clone());
         outputs.push(save.display().to_string());
     }
 
@@ -458,6 +527,13 @@ fn check_save_path(path: &std::path::Path) -> Result<(), Error> {
     }
     let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
     if let Some(dir) = parent {
+        if dir.is_file() {
+            return Err(Error::Invalid(format!(
+                "--save {}: {} is a file, not a folder",
+                path.display(),
+                dir.display()
+            )));
+        }
         if !dir.is_dir() {
             return Err(Error::Invalid(format!(
                 "--save {}: the folder {} does not exist",
@@ -539,7 +615,7 @@ pub fn info(
     mesh_opts: &MeshOptions,
 ) -> Result<report::SceneInfo, Error> {
     let scene = load_scene(source, load)?;
-    let m = mesh::build(&scene, mesh_opts);
+    let m = build_mesh(&scene, mesh_opts)?;
     Ok(report::scene_info(
         &scene,
         &m,
@@ -627,7 +703,7 @@ pub fn bench_rays(
         ..cfg.clone()
     };
     let scene = load_scene(source, load)?;
-    let m = mesh::build(&scene, mesh_opts);
+    let m = build_mesh(&scene, mesh_opts)?;
     let (isect, chosen) = select::select(&m, kind)?;
     let (lo, hi) = scene.bounds();
     // Warm up (page in the BVH, spin up the threads). Then alternate raw measurements and

@@ -12,7 +12,7 @@
 //! one at a time on one thread: thread time per shot, the unit the hybrid's switch compares.
 
 use crate::intersect::embree::EmbreeScene;
-use crate::mesh::{self, MeshOptions};
+use crate::mesh::MeshOptions;
 use crate::pipeline::{load_scene, SceneSource};
 use crate::sample::hemicube::{Hemicube, HemicubeBuffer};
 use crate::sample::Frame;
@@ -116,7 +116,7 @@ pub fn bench_shots(
     shooters: usize,
 ) -> Result<ShotBench, Error> {
     let scene = load_scene(source, load)?;
-    let m = mesh::build(&scene, mesh_opts);
+    let m = crate::pipeline::build_mesh(&scene, mesh_opts)?;
     let n = m.patches.len();
     let count = shooters.clamp(1, n.max(1));
     let from: Vec<usize> = (0..count).map(|k| k * n / count).collect();

@@ -42,19 +42,52 @@ pub fn write_atomic(
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
-    result.map_err(err)
+    result.map_err(|e| err(file_in_the_way(path).unwrap_or(e)))
+}
+
+/// A regular file where a folder of `path` should be, as an error that names it.
+fn file_in_the_way(path: &Path) -> Option<std::io::Error> {
+    let file = path.ancestors().skip(1).find(|a| a.is_file())?;
+    Some(std::io::Error::other(format!(
+        "{} is a file, not a folder",
+        file.display()
+    )))
 }
 
 /// Makes sure `dir` exists and is writable, before any work is spent on what goes into it.
-pub fn prepare_dir(dir: &Path) -> Result<(), WriteError> {
+/// Returns the folders it created, deepest first, for [`remove_made_dirs`] if the work fails.
+pub fn prepare_dir(dir: &Path) -> Result<Vec<PathBuf>, WriteError> {
     let err = |source| WriteError {
         path: dir.to_path_buf(),
         source,
     };
-    std::fs::create_dir_all(dir).map_err(err)?;
+    // A regular file where a folder should be: say so rather than "File exists".
+    if let Some(e) = file_in_the_way(&dir.join("x")) {
+        return Err(err(e));
+    }
+    let made: Vec<PathBuf> = dir
+        .ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .map(Path::to_path_buf)
+        .collect();
     let probe = dir.join(".radiosity-write-test");
-    std::fs::write(&probe, b"").map_err(err)?;
-    std::fs::remove_file(&probe).map_err(err)
+    let result = std::fs::create_dir_all(dir)
+        .and_then(|()| std::fs::write(&probe, b""))
+        .and_then(|()| std::fs::remove_file(&probe));
+    if let Err(e) = result {
+        remove_made_dirs(&made);
+        return Err(err(e));
+    }
+    Ok(made)
+}
+
+/// Removes the folders [`prepare_dir`] created, deepest first, as far as they are empty.
+pub fn remove_made_dirs(made: &[PathBuf]) {
+    for dir in made {
+        if std::fs::remove_dir(dir).is_err() {
+            break;
+        }
+    }
 }
 
 /// The exposure for display colours of per-vertex radiosity: `Some(e)` (finite, ≥ 0) as given,

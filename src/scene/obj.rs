@@ -109,6 +109,8 @@ fn load(name: &str, text: &str, mtl: MtlSource, opts: &LoadOptions) -> Result<Sc
     let requested = prescan(text).map_err(fail)?;
 
     // Parse. Polygons stay polygons; points and lines (`p`, `l`) are not surfaces.
+    // tobj reads an `l` line of 3 or more vertices as a polygon: hide `l` lines from it.
+    let surfaces = without_lines(text);
     let log = RefCell::new(MtlLog::default());
     let tobj_options = tobj::LoadOptions {
         triangulate: false,
@@ -118,7 +120,7 @@ fn load(name: &str, text: &str, mtl: MtlSource, opts: &LoadOptions) -> Result<Sc
     };
     // tobj has panicked on malformed input before; a panic must not escape as one.
     let parsed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        tobj::load_obj_buf(&mut text.as_bytes(), &tobj_options, |lib| {
+        tobj::load_obj_buf(&mut surfaces.as_bytes(), &tobj_options, |lib| {
             load_library(lib, &mtl, &mut log.borrow_mut())
         })
     }));
@@ -559,6 +561,22 @@ fn check_mtl(text: &str) -> Result<Option<String>, String> {
     Ok(fixed)
 }
 
+/// The text with every `l` (polyline) line emptied, line numbers kept; borrowed if it has none.
+fn without_lines(text: &str) -> std::borrow::Cow<'_, str> {
+    let is_line = |line: &str| line.split_whitespace().next() == Some("l");
+    if !text.lines().any(is_line) {
+        return text.into();
+    }
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        if !is_line(line) {
+            out.push_str(line);
+        }
+        out.push('\n');
+    }
+    out.into()
+}
+
 /// One pass over the OBJ text: reject faces of fewer than 3 vertices (tobj drops them
 /// silently) and collect the material names `usemtl` asks for.
 fn prescan(text: &str) -> Result<HashSet<String>, String> {
@@ -570,8 +588,9 @@ fn prescan(text: &str) -> Result<HashSet<String>, String> {
                 let n = words.count();
                 if n < 3 {
                     return Err(format!(
-                        "line {}: a face with {n} vertices (a polygon needs at least 3): `{}`",
+                        "line {}: a face with {n} {} (a polygon needs at least 3): `{}`",
                         i + 1,
+                        if n == 1 { "vertex" } else { "vertices" },
                         snippet(line)
                     ));
                 }
@@ -1313,12 +1332,16 @@ mod tests {
 
     #[test]
     fn faces_of_fewer_than_three_vertices_are_errors() {
-        for (face, n) in [("f 1 2", 2), ("f 1", 1), ("f", 0)] {
+        for (face, n) in [
+            ("f 1 2", "2 vertices"),
+            ("f 1", "1 vertex"),
+            ("f", "0 vertices"),
+        ] {
             let obj = format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n{face}\n");
             assert_error(
                 load_strs(&obj, ""),
                 "test.obj",
-                &["line 5", &format!("a face with {n} vertices")],
+                &["line 5", &format!("a face with {n} ")],
             );
         }
         // Lines and points are not faces and are skipped.
@@ -1338,6 +1361,14 @@ mod tests {
         assert_error(load_strs(obj, ""), "test.obj", &["line 4", "index 0"]);
         let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n";
         assert_error(load_strs(obj, ""), "test.obj", &["line 4", "vertex -4"]);
+    }
+
+    #[test]
+    fn polylines_of_three_or_more_vertices_are_not_polygons() {
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\nl 1 2 3 1\n";
+        assert_error(load_strs(obj, ""), "test.obj", &["no polygons"]);
+        let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\nf 1 2 3\n";
+        assert_eq!(load_strs(obj, "").unwrap().polygons.len(), 1);
     }
 
     #[test]
