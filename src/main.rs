@@ -15,6 +15,27 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 
+/// `println!` that ends the process quietly when standard output is closed (`radiosity info |
+/// head -1`) instead of panicking on the broken pipe.
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if writeln!(std::io::stdout(), $($arg)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+
+/// `print!` likewise.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        if write!(std::io::stdout(), $($arg)*).is_err() {
+            std::process::exit(0);
+        }
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "radiosity",
@@ -799,12 +820,12 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
             })?;
             drop(progress);
             if a.json {
-                println!(
+                outln!(
                     "{}",
                     serde_json::to_string_pretty(&summary).unwrap_or_default()
                 );
             } else if !a.quiet {
-                println!(
+                outln!(
                     "{}: {} patches, {} shots, {} rays in {:.2} s; {}; energy balance residual {:.1e}; outputs in {}{}",
                     summary.scene,
                     summary.patches,
@@ -881,7 +902,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 },
             };
             let st = generate_building(&out, &opts)?;
-            println!(
+            outln!(
                 "{}: {} floors × {} rooms, {} polygons, about {} patches at {} m, {} lights",
                 out.display(),
                 opts.floors,
@@ -900,12 +921,12 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
         } => {
             let info = pipeline::info(&source(scene), &scene_args.load(), &scene_args.mesh())?;
             if json {
-                println!(
+                outln!(
                     "{}",
                     serde_json::to_string_pretty(&info).unwrap_or_default()
                 );
             } else {
-                print!("{info}");
+                out!("{info}");
             }
             Ok(())
         }
@@ -930,7 +951,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 &resolutions,
                 shooters,
             )?;
-            print!("{}", b.markdown());
+            out!("{}", b.markdown());
             if let Some(path) = out {
                 radiosity::export::write_atomic(&path, |w| {
                     serde_json::to_writer_pretty(&mut *w, &b).map_err(std::io::Error::other)
@@ -967,9 +988,9 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 out: a.out.clone(),
                 seed: a.building_seed,
             };
-            let rows = radiosity::sweep::run(&job, |l| println!("{l}"))?;
-            println!("{}", radiosity::sweep::markdown(&rows, &job.methods));
-            println!("outputs in {}", a.out.display());
+            let rows = radiosity::sweep::run(&job, |l| outln!("{l}"))?;
+            outln!("{}", radiosity::sweep::markdown(&rows, &job.methods));
+            outln!("outputs in {}", a.out.display());
             Ok(())
         }
         Command::Compare(a) => {
@@ -1005,7 +1026,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 out: a.out.clone(),
             };
             let cmp = compare::run_compare(&job, |line| eprintln!("{line}"))?;
-            print!("{}", compare::report::markdown(&cmp));
+            out!("{}", compare::report::markdown(&cmp));
             eprintln!("outputs in {}", a.out.display());
             Ok(())
         }
@@ -1040,7 +1061,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                     r.scene, r.shape.patches, r.embree.mrays, r.hybrid.mrays
                 )
             })?;
-            print!("{}", radiosity::intersect::bench::markdown(&rows));
+            out!("{}", radiosity::intersect::bench::markdown(&rows));
             if let Some(path) = out {
                 let text = radiosity::intersect::bench::csv(&rows);
                 radiosity::export::write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
@@ -1069,7 +1090,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 rays,
                 min_seconds,
             )?;
-            println!(
+            outln!(
                 "{}: {} triangles, {} patches, {} threads\n  raw {} closest hit: {:.2} Mrays/s ({} rays; {:.2} to {:.2} over the run)\n  solver:                 {:.2} Mrays/s ({} rays in {} solves)\n  solver / raw:           {:.0} %",
                 b.scene,
                 b.triangles,
@@ -1113,9 +1134,9 @@ fn crosscheck(a: CrosscheckArgs) -> Result<(), radiosity::Error> {
     let c = intersect_jobs::crosscheck(&job)?;
     let json = serde_json::to_string_pretty(&c).unwrap_or_default();
     if a.json {
-        println!("{json}");
+        outln!("{json}");
     } else {
-        print!("{c}");
+        out!("{c}");
     }
     if let Some(path) = a.out {
         let text = if path
@@ -1163,16 +1184,20 @@ fn render_job(a: RenderArgs) -> radiosity::outputs::RenderJob {
 /// The one-line report of `render` and `export`, or its JSON.
 fn print_output_report(r: &radiosity::outputs::OutputReport, json: bool, quiet: bool) {
     if json {
-        println!("{}", serde_json::to_string_pretty(r).unwrap_or_default());
+        outln!("{}", serde_json::to_string_pretty(r).unwrap_or_default());
     } else if !quiet {
         let extra = match (&r.scale, r.exposure) {
             (Some(s), _) => format!(", irradiance {}–{} W/m² on a log scale", s.lo, s.hi),
             (None, Some(e)) => format!(", exposure {e:.4}"),
             (None, None) => ", linear radiosity in W/m²".to_string(),
         };
-        println!(
+        outln!(
             "{}: {} of {} ({} patches, {} vertices){extra}",
-            r.out, r.format, r.scene, r.patches, r.vertices
+            r.out,
+            r.format,
+            r.scene,
+            r.patches,
+            r.vertices
         );
     }
 }

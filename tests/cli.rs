@@ -476,3 +476,22 @@ fn a_small_sweep_writes_its_table_and_plots() {
     }
     assert_user_error(&["sweep", "--sizes", "0", "--out", "x"], &["--sizes"]);
 }
+
+/// A reader that stops early (`radiosity info … | head -1`) ends the command quietly, without
+/// a panic on the broken pipe.
+#[test]
+fn a_closed_standard_output_is_not_a_panic() {
+    let bin = assert_cmd::cargo::cargo_bin("radiosity");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/church.obj");
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "'{}' info '{}' | true",
+            bin.display(),
+            scene.display()
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+}
