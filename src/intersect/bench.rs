@@ -57,6 +57,10 @@ pub struct BenchRow {
     pub fastest: String,
     /// Hybrid Mrays/s over Embree's.
     pub hybrid_over_embree: f64,
+    /// Where the merge's time goes (over up to 100 k of the rays): planes whose crossing was
+    /// tested, and point locations inside a plane's bounds, per ray.
+    pub merge_planes_per_ray: Option<f64>,
+    pub merge_locates_per_ray: Option<f64>,
 }
 
 /// Mrays/s of `isect` over `rays`, all threads, after a warm-up over a tenth of them.
@@ -137,6 +141,15 @@ pub fn bench_mesh(
         }
     }
     let (embree, hybrid) = (embree.expect("measured"), hybrid.expect("measured"));
+    let walk = m.as_ref().map(|(m, _)| {
+        let sample = &test[..test.len().min(100_000)];
+        let mut c = crate::intersect::plane_merge::WalkCount::default();
+        for r in sample {
+            std::hint::black_box(m.intersect_counted(r, &mut c));
+        }
+        let n = sample.len().max(1) as f64;
+        (c.planes as f64 / n, c.locates as f64 / n)
+    });
     let merge_subset = shape.skew > 0;
     let mut fastest = ("embree", embree.mrays);
     for (n, r) in [
@@ -160,6 +173,8 @@ pub fn bench_mesh(
             Some(RaySource::Uniform) => "uniform",
         },
         hybrid_over_embree: hybrid.mrays / embree.mrays.max(1e-12),
+        merge_planes_per_ray: walk.map(|w| w.0),
+        merge_locates_per_ray: walk.map(|w| w.1),
         embree,
         merge,
         merge_subset,
@@ -213,6 +228,23 @@ pub fn markdown(rows: &[BenchRow]) -> String {
          *: the merge over the axial patches only (the scene has skew ones, which it misses), \
          not usable alone; not counted for \"fastest\"."
     );
+    let walks: Vec<String> = rows
+        .iter()
+        .filter_map(|r| {
+            Some(format!(
+                "{} {:.1} / {:.1}",
+                r.scene, r.merge_planes_per_ray?, r.merge_locates_per_ray?
+            ))
+        })
+        .collect();
+    if !walks.is_empty() {
+        let _ = writeln!(
+            s,
+            "\nThe merge's work per ray (planes whose crossing was tested / point locations inside \
+             a plane's bounds): {}.",
+            walks.join("; ")
+        );
+    }
     s
 }
 

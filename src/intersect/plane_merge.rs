@@ -755,12 +755,54 @@ impl SkewEdges {
     }
 }
 
-impl Intersector for PlaneMerge {
+/// What one walk through the planes did (for `radiosity bench intersect`, to see where the
+/// merge's time goes): planes whose crossing point was tested, and point locations inside a
+/// plane's bounds.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct WalkCount {
+    pub planes: u64,
+    pub locates: u64,
+}
+
+/// Counts the work of a walk, or not: the solver's path uses [`NoCount`], which compiles away.
+pub trait Counter {
+    fn plane(&mut self);
+    fn locate(&mut self);
+}
+
+/// No counting (the solver's path).
+pub struct NoCount;
+
+impl Counter for NoCount {
+    #[inline(always)]
+    fn plane(&mut self) {}
+    #[inline(always)]
+    fn locate(&mut self) {}
+}
+
+impl Counter for WalkCount {
+    #[inline]
+    fn plane(&mut self) {
+        self.planes += 1;
+    }
+    #[inline]
+    fn locate(&mut self) {
+        self.locates += 1;
+    }
+}
+
+impl PlaneMerge {
+    /// [`Intersector::intersect`] that also counts its work into `count`.
+    pub fn intersect_counted(&self, ray: &Ray, count: &mut WalkCount) -> Option<Hit> {
+        self.walk(ray, count)
+    }
+
     /// Sec. 2, Fig. 4: the three-way merge. Each axis the ray is not parallel to contributes
     /// its planes in crossing order; the stream with the smallest next t is tested and advanced
     /// until a plane has a polygon under the crossing point or t passes tfar.
     #[allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x <= y)`: NaN must fail these tests
-    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+    #[inline]
+    fn walk<C: Counter>(&self, ray: &Ray, count: &mut C) -> Option<Hit> {
         let o = ray.org.to_array();
         let d = ray.dir.to_array();
         let mut inv = [0.0f32; 3];
@@ -837,9 +879,11 @@ impl Intersector for PlaneMerge {
                 let pi = i as usize;
                 let pu = o[u] + t * d[u];
                 let pv = o[v] + t * d[v];
+                count.plane();
                 // The plane's bounds (NaN falls outside), then its grid.
                 let p = Vec4::new(pu, pv, -pu, -pv);
                 if p.cmpge(self.bounds[pi]).bitmask() == 0xF {
+                    count.locate();
                     match self.locate(pi, pu, pv, d[a]) {
                         Found::Nothing => {}
                         Found::Owner(p) => return hit(p, a, t),
@@ -871,6 +915,13 @@ impl Intersector for PlaneMerge {
                 }
             }
         }
+    }
+}
+
+impl Intersector for PlaneMerge {
+    #[inline]
+    fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.walk(ray, &mut NoCount)
     }
 
     fn name(&self) -> &'static str {
