@@ -465,7 +465,26 @@ impl Hemicube {
                 }
             }
 
+            // A face sees only points ahead of it (w > 0): a face none of the (clipped)
+            // polygon's vertices is ahead of cannot see any of it, and is skipped before the
+            // mapping and the frustum tests (most patches reach one to three faces, not five).
+            let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+            for q in local.iter() {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(q[k]);
+                    hi[k] = hi[k].max(q[k]);
+                }
+            }
             for face in &self.faces {
+                let (w_axis, w_sign) = face.axes[0];
+                let ahead = if w_sign > 0.0 {
+                    hi[w_axis] > 0.0
+                } else {
+                    lo[w_axis] < 0.0
+                };
+                if !ahead {
+                    continue;
+                }
                 // Into the face's (w, u·w, v·w) and clipped to its frustum.
                 clip_a.clear();
                 clip_a.extend(local.iter().map(|&q| face.map(q)));
