@@ -286,6 +286,10 @@ struct CompareArgs {
         allow_negative_numbers = true
     )]
     levels: Vec<f64>,
+    /// Run every method this many times in interleaved rounds and keep each one's run of
+    /// median solve time (steadier figures for solves of milliseconds).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    repeat: usize,
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Relative sampling error of the compared runs (sets the rays' energy, as in solve).
@@ -1023,6 +1027,7 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 },
                 intersector: a.intersector.into(),
                 levels: a.levels,
+                repeat: a.repeat,
                 out: a.out.clone(),
             };
             let cmp = compare::run_compare(&job, |line| eprintln!("{line}"))?;

@@ -115,6 +115,8 @@ fn compare_writes_csv_plots_and_markdown() {
             "40",
             "--reference-tolerance",
             "0.02",
+            "--repeat",
+            "3",
             "--out",
         ])
         .arg(dir.path())
@@ -122,6 +124,8 @@ fn compare_writes_csv_plots_and_markdown() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
+    // --repeat 3: three rounds of every method, one kept each.
+    assert!(err.contains("hemicube (round 3)"), "{err}");
     let csv = std::fs::read_to_string(dir.path().join("compare.csv")).unwrap();
     let mut lines = csv.lines();
     assert!(lines.next().unwrap().starts_with("method,time_s,shots,"));
@@ -146,8 +150,9 @@ fn compare_writes_csv_plots_and_markdown() {
 #[test]
 fn compare_rejects_bad_settings_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[&str], &str); 4] = [
+    let cases: [(&[&str], &str); 5] = [
         (&["--budget", "0"], "--budget"),
+        (&["--budget", "1", "--repeat", "0"], "--repeat"),
         (
             &["--budget", "1", "--methods", "hemicube,hemicube"],
             "twice",

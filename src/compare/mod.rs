@@ -136,6 +136,9 @@ pub struct CompareJob {
     /// Error levels (fractions) of the time-to-error table.
     pub levels: Vec<f64>,
     pub out: PathBuf,
+    /// Run every method this many times, in interleaved rounds, and keep each method's run of
+    /// median solve time (millisecond solves are at the mercy of the machine's noise).
+    pub repeat: usize,
 }
 
 /// One method's run.
@@ -183,6 +186,12 @@ pub struct Comparison {
 }
 
 fn validate(job: &CompareJob) -> Result<(), Error> {
+    if !(1..=100).contains(&job.repeat) {
+        return Err(Error::Invalid(format!(
+            "--repeat must be between 1 and 100, got {}",
+            job.repeat
+        )));
+    }
     if job.methods.is_empty() {
         return Err(Error::Invalid("--methods names no method".into()));
     }
@@ -271,38 +280,55 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
     };
     let b_ref = Arc::new(b_ref);
 
-    let mut runs = Vec::new();
-    for &method in &job.methods {
-        let cfg = SolveConfig {
-            method,
-            max_time: Some(job.budget),
-            reference: Some(b_ref.clone()),
-            switch_at: None,
-            ..job.solve.clone()
-        };
-        let sol = solve::run(&m, &scene.materials, isect.as_ref(), &cfg, |_| {}).map_err(fail)?;
-        let last = sol.stats.trace.last();
-        let run = MethodRun {
-            method,
-            seconds: sol.stats.seconds,
-            shots: sol.stats.shots,
-            rays: sol.stats.rays,
-            cells: last.map_or(sol.stats.hemicube_cells, |p| p.cells),
-            stop_reason: sol.stats.stop_reason,
-            switch: sol.stats.switch,
-            error: last.and_then(|p| p.error),
-            trace: sol.stats.trace.clone(),
-        };
-        log(&format!(
-            "{}: {} shots, {} form factors in {:.2} s; error {:.2} % (average weighted percent)",
-            method.name(),
-            run.shots,
-            run.form_factors(),
-            run.seconds,
-            100.0 * run.error.map_or(0.0, |e| e.weighted_percent)
-        ));
-        runs.push(run);
+    // Rounds of every method in turn: a burst of load on the shared machine then hits all
+    // methods alike; each keeps its median run.
+    let mut all: Vec<Vec<MethodRun>> = job.methods.iter().map(|_| Vec::new()).collect();
+    for round in 0..job.repeat.max(1) {
+        for (k, &method) in job.methods.iter().enumerate() {
+            let cfg = SolveConfig {
+                method,
+                max_time: Some(job.budget),
+                reference: Some(b_ref.clone()),
+                switch_at: None,
+                ..job.solve.clone()
+            };
+            let sol =
+                solve::run(&m, &scene.materials, isect.as_ref(), &cfg, |_| {}).map_err(fail)?;
+            let last = sol.stats.trace.last();
+            let run = MethodRun {
+                method,
+                seconds: sol.stats.seconds,
+                shots: sol.stats.shots,
+                rays: sol.stats.rays,
+                cells: last.map_or(sol.stats.hemicube_cells, |p| p.cells),
+                stop_reason: sol.stats.stop_reason,
+                switch: sol.stats.switch,
+                error: last.and_then(|p| p.error),
+                trace: sol.stats.trace.clone(),
+            };
+            log(&format!(
+                "{}{}: {} shots, {} form factors in {:.2} s; error {:.2} % (average weighted percent)",
+                method.name(),
+                if job.repeat > 1 {
+                    format!(" (round {})", round + 1)
+                } else {
+                    String::new()
+                },
+                run.shots,
+                run.form_factors(),
+                run.seconds,
+                100.0 * run.error.map_or(0.0, |e| e.weighted_percent)
+            ));
+            all[k].push(run);
+        }
     }
+    let runs: Vec<MethodRun> = all
+        .into_iter()
+        .map(|mut v| {
+            v.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
+            v.swap_remove(v.len() / 2)
+        })
+        .collect();
     let cmp = Comparison {
         scene: scene.name.clone(),
         patches: m.patches.len(),
