@@ -5,7 +5,7 @@
 use crate::generate::{self, BuildingOptions};
 use crate::intersect::bench::{self, BenchRow};
 use crate::intersect::crosscheck::{self, CrossReport, RaySource};
-use crate::mesh::{self, MeshOptions};
+use crate::mesh::MeshOptions;
 use crate::pipeline::{load_scene, SceneSource};
 use crate::scene::{self, LoadOptions, Scene};
 use crate::Error;
@@ -150,7 +150,7 @@ pub fn bench_intersect(
     }
     for &n in &job.generated {
         let scene = generated_building(n)?;
-        let m = mesh::build(&scene, &MeshOptions::default());
+        let m = crate::pipeline::build_mesh(&scene, &MeshOptions::default())?;
         drop(scene);
         let row = bench::bench_mesh(&format!("building-{}", short(n)), &m, rays, seed, from)?;
         log(&row);

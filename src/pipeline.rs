@@ -143,30 +143,7 @@ pub fn validate(job: &SolveJob) -> Result<(), Error> {
             job.checkpoint_every
         )));
     }
-    if s.switch_at.is_some() && s.method != MethodKind::AdaptiveHybrid {
-        return Err(Error::Invalid(format!(
-            "--switch-at applies to --method adaptive-hybrid only, not {}",
-            s.method.name()
-        )));
-    }
-    if !(2..=4096).contains(&s.hemicube_n) {
-        return Err(Error::Invalid(format!(
-            "--hemicube-n must be between 2 and 4096, got {}",
-            s.hemicube_n
-        )));
-    }
-    if !(s.tolerance > 0.0 && s.tolerance < 1.0) {
-        return Err(Error::Invalid(format!(
-            "--tolerance must be in (0, 1), got {}",
-            s.tolerance
-        )));
-    }
-    if !(s.stop_fraction > 0.0 && s.stop_fraction.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "--stop must be a positive fraction, got {}",
-            s.stop_fraction
-        )));
-    }
+    s.check().map_err(Error::Invalid)?;
     if let Some(ps) = job.mesh.patch_size {
         if !(ps > 0.0 && ps.is_finite()) {
             return Err(Error::Invalid(format!(

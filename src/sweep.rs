@@ -15,7 +15,7 @@ use crate::export::write_atomic;
 use crate::generate::{self, BuildingOptions};
 use crate::intersect::select::{self, IntersectorKind};
 use crate::intersect::Intersector;
-use crate::mesh::{self, MeshOptions};
+use crate::mesh::MeshOptions;
 use crate::scene::{self, LoadOptions};
 use crate::solve::{self, MethodKind, SolveConfig};
 use crate::Error;
@@ -165,7 +165,7 @@ fn run_one(
     let scene = scene::load_obj(obj, &LoadOptions::default())?;
     let load_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let m = mesh::build(&scene, &MeshOptions::default());
+    let m = crate::pipeline::build_mesh(&scene, &MeshOptions::default())?;
     let mesh_s = t.elapsed().as_secs_f64();
     let (before, _) = rss_kib();
     let t = Instant::now();

@@ -150,8 +150,9 @@ fn compare_writes_csv_plots_and_markdown() {
 #[test]
 fn compare_rejects_bad_settings_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let cases: [(&[&str], &str); 6] = [
         (&["--budget", "0"], "--budget"),
+        (&["--budget", "1", "--patch-size", "0.0001"], "--patch-size"),
         (&["--budget", "1", "--repeat", "0"], "--repeat"),
         (
             &["--budget", "1", "--methods", "hemicube,hemicube"],

@@ -14,7 +14,7 @@ pub mod report;
 use crate::export::{self, patches, write_atomic};
 use crate::intersect::select::{self, IntersectorKind};
 use crate::intersect::Intersector;
-use crate::mesh::{self, MeshOptions};
+use crate::mesh::MeshOptions;
 use crate::pipeline::{load_reference, load_scene, SceneSource};
 use crate::scene::LoadOptions;
 use crate::solve::error::ErrorMetrics;
@@ -50,29 +50,13 @@ struct ReferenceSummary<'a> {
     reference: &'a Reference,
 }
 
-fn check_reference_settings(s: &SolveConfig) -> Result<(), Error> {
-    if !(s.tolerance > 0.0 && s.tolerance < 1.0) {
-        return Err(Error::Invalid(format!(
-            "--tolerance must be in (0, 1), got {}",
-            s.tolerance
-        )));
-    }
-    if !(s.stop_fraction > 0.0 && s.stop_fraction.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "--stop must be a positive fraction, got {}",
-            s.stop_fraction
-        )));
-    }
-    Ok(())
-}
-
 /// `radiosity reference`: solves the reference, writes `patches.csv` and `summary.json` into
 /// `job.out`, and fails ([`Error::Failed`], after writing) if the check of its bound fails.
 pub fn run_reference(job: &ReferenceJob, mut log: impl FnMut(&str)) -> Result<Reference, Error> {
-    check_reference_settings(&job.solve)?;
+    job.solve.check().map_err(Error::Invalid)?;
     export::prepare_dir(&job.out)?;
     let scene = load_scene(&job.source, &job.load)?;
-    let m = mesh::build(&scene, &job.mesh);
+    let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
     log(&format!(
         "{}: {} patches at {} m",
         scene.name,
@@ -215,15 +199,11 @@ fn validate(job: &CompareJob) -> Result<(), Error> {
         )));
     }
     let s = &job.solve;
-    if !(2..=4096).contains(&s.hemicube_n) {
-        return Err(Error::Invalid(format!(
-            "--hemicube-n must be between 2 and 4096, got {}",
-            s.hemicube_n
-        )));
-    }
-    check_reference_settings(s)?;
+    s.check().map_err(Error::Invalid)?;
     if job.reference.is_none() {
-        check_reference_settings(&job.reference_solve)
+        job.reference_solve
+            .check()
+            .map_err(Error::Invalid)
             .map_err(|e| Error::Invalid(format!("reference: {e}")))?;
     }
     Ok(())
@@ -235,7 +215,7 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
     validate(job)?;
     export::prepare_dir(&job.out)?;
     let scene = load_scene(&job.source, &job.load)?;
-    let m = mesh::build(&scene, &job.mesh);
+    let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
     log(&format!(
         "{}: {} patches at {} m",
         scene.name,

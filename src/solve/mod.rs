@@ -125,6 +125,37 @@ impl Default for SolveConfig {
     }
 }
 
+impl SolveConfig {
+    /// Checks the settings a user can get wrong (one line naming the flag), before any work.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return Err(format!(
+                "--tolerance must be in (0, 1), got {}",
+                self.tolerance
+            ));
+        }
+        if !(self.stop_fraction > 0.0 && self.stop_fraction.is_finite()) {
+            return Err(format!(
+                "--stop must be a positive fraction, got {}",
+                self.stop_fraction
+            ));
+        }
+        if !(2..=4096).contains(&self.hemicube_n) {
+            return Err(format!(
+                "--hemicube-n must be between 2 and 4096, got {}",
+                self.hemicube_n
+            ));
+        }
+        if self.switch_at.is_some() && self.method != MethodKind::AdaptiveHybrid {
+            return Err(format!(
+                "--switch-at applies to --method adaptive-hybrid only, not {}",
+                self.method.name()
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Why the solve stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
