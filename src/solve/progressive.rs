@@ -412,6 +412,7 @@ pub fn shoot<I: Intersector>(
     let mut next_trace_shots = stats.shots;
     let mut last_sync: Option<u64> = None;
     let mut next_checkpoint = time_offset;
+    let mut interrupt_now = false;
     let stop_reason = loop {
         let elapsed = time_offset + start.elapsed().as_secs_f64();
         // A safe point every SYNC_WAVES waves, whether or not anyone checkpoints (so runs
@@ -446,19 +447,8 @@ pub fn shoot<I: Intersector>(
                     next_checkpoint = elapsed + sink.every.as_secs_f64();
                 }
             }
-            if interrupted {
-                let max_b = st.max_unshot_b();
-                st.record(
-                    &mut stats,
-                    elapsed,
-                    max_b,
-                    &est,
-                    reference,
-                    0.0,
-                    &mut on_trace,
-                );
-                break StopReason::Interrupted;
-            }
+            // Only here, at a safe point, so a resumed run repeats the same shots.
+            interrupt_now = interrupted;
         }
         // Sec. 3's criterion, then the budgets.
         let max_b = st.max_unshot_b();
@@ -473,7 +463,9 @@ pub fn shoot<I: Intersector>(
             .map_or(0.0, |p| p.wave.iter().map(|s| scalar(&s.phi)).sum::<f64>());
         // Sec. 3's criterion, on the light unshot radiosity will still add (see
         // `State::amplification`).
-        let reason = if max_b * st.amplification(flying) < cfg.stop_fraction * mean_b {
+        let reason = if interrupt_now {
+            Some(StopReason::Interrupted)
+        } else if max_b * st.amplification(flying) < cfg.stop_fraction * mean_b {
             // The max-ΔB heap holds only patches above the threshold; whether any energy at
             // all is left, the flux heap says.
             if st.has_unshot() {
