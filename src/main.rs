@@ -140,15 +140,9 @@ impl CheckArgs {
     }
 }
 
+/// The camera and the image (`solve`, `render`, `relight`).
 #[derive(Args)]
-struct RenderArgs {
-    /// The saved solution (`radiosity solve --save FILE.rad`).
-    solution: PathBuf,
-    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiosity, W/m²).
-    #[arg(long)]
-    out: PathBuf,
-    #[command(flatten)]
-    check: CheckArgs,
+struct ViewArgs {
     /// Camera position X,Y,Z (default: fitted to the scene, looking along −z).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     eye: Option<Vec3>,
@@ -171,6 +165,39 @@ struct RenderArgs {
     /// Exposure multiplier on radiosity for PNG (default: automatic).
     #[arg(long, allow_negative_numbers = true)]
     exposure: Option<f32>,
+}
+
+impl ViewArgs {
+    fn camera(&self) -> CameraSpec {
+        CameraSpec {
+            eye: self.eye,
+            target: self.target,
+            up: self.up,
+            fov_y_deg: self.fov,
+        }
+    }
+
+    fn render(&self) -> RenderOptions {
+        RenderOptions {
+            width: self.width,
+            height: self.height,
+            supersample: self.supersample,
+            exposure: self.exposure,
+        }
+    }
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// The saved solution (`radiosity solve --save FILE.rad`).
+    solution: PathBuf,
+    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiosity, W/m²).
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    check: CheckArgs,
+    #[command(flatten)]
+    view: ViewArgs,
     /// Irradiance in false colour on a log scale, with a legend in W/m² (PNG only).
     #[arg(long, alias = "false-color")]
     false_colour: bool,
@@ -611,25 +638,8 @@ struct SolveArgs {
     /// `radiosity reference`): the trace then records the error against it.
     #[arg(long, value_name = "PATCHES.csv")]
     reference: Option<PathBuf>,
-    /// Camera position X,Y,Z (default: fitted to the scene, looking along −z).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    eye: Option<Vec3>,
-    /// Point the camera looks at X,Y,Z (default: the scene's centre).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    target: Option<Vec3>,
-    /// Camera up direction X,Y,Z (default 0,1,0).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
-    up: Option<Vec3>,
-    /// Vertical field of view in degrees.
-    #[arg(long, allow_negative_numbers = true)]
-    fov: Option<f32>,
-    #[arg(long, default_value_t = 640)]
-    width: u32,
-    #[arg(long, default_value_t = 480)]
-    height: u32,
-    /// Exposure multiplier on radiosity (default: automatic).
-    #[arg(long, allow_negative_numbers = true)]
-    exposure: Option<f32>,
+    #[command(flatten)]
+    view: ViewArgs,
     /// Print nothing but errors.
     #[arg(long, short)]
     quiet: bool,
@@ -796,18 +806,8 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 out: a.out.clone(),
                 reference: a.reference.clone(),
                 intersector: a.solve_args.intersector.into(),
-                camera: CameraSpec {
-                    eye: a.eye,
-                    target: a.target,
-                    up: a.up,
-                    fov_y_deg: a.fov,
-                },
-                render: RenderOptions {
-                    width: a.width,
-                    height: a.height,
-                    exposure: a.exposure,
-                    ..RenderOptions::default()
-                },
+                camera: a.view.camera(),
+                render: a.view.render(),
                 save: a.save.clone(),
                 per_light: a.per_light.then_some(a.light_groups.into()),
                 checkpoint: a.checkpoint.clone(),
@@ -1170,18 +1170,8 @@ fn render_job(a: RenderArgs) -> radiosity::outputs::RenderJob {
         solution: a.solution,
         check: a.check.check(None),
         out: a.out,
-        camera: CameraSpec {
-            eye: a.eye,
-            target: a.target,
-            up: a.up,
-            fov_y_deg: a.fov,
-        },
-        render: RenderOptions {
-            width: a.width,
-            height: a.height,
-            supersample: a.supersample,
-            exposure: a.exposure,
-        },
+        camera: a.view.camera(),
+        render: a.view.render(),
         false_colour: a.false_colour,
     }
 }
