@@ -2,7 +2,8 @@
 //! uninterrupted one does, for the same seed; Ctrl-C (the interrupt flag) stops at a safe
 //! point with a checkpoint; corrupt, truncated or foreign checkpoints are refused.
 
-use assert_cmd::Command;
+mod common;
+
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::{self, LoadOptions, Scene};
@@ -143,25 +144,13 @@ fn an_interrupt_stops_at_a_safe_point_with_a_checkpoint() {
     assert_eq!(resumed.b, plain.b);
 }
 
-fn cli(args: &[&str]) -> (i32, String) {
-    let out = Command::cargo_bin("radiosity")
-        .unwrap()
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn command_line_checkpoints_and_refusals() {
     let dir = tempfile::tempdir().unwrap();
     let p = |n: &str| dir.path().join(n).display().to_string();
     let blocks = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/blocks.obj");
     let blocks = blocks.to_str().unwrap();
-    let (code, err) = cli(&[
+    let (code, _, err) = common::run(&[
         "solve",
         blocks,
         "--method",
@@ -175,7 +164,7 @@ fn command_line_checkpoints_and_refusals() {
     assert_eq!(code, 0, "{err}");
     let bytes = std::fs::read(p("c.ckpt")).unwrap();
     // Resuming the finished run's checkpoint finishes at once, with the same table.
-    let (code, err) = cli(&[
+    let (code, _, err) = common::run(&[
         "solve",
         blocks,
         "--method",
@@ -189,7 +178,7 @@ fn command_line_checkpoints_and_refusals() {
     assert_eq!(code, 0, "{err}");
     // Another seed, another scene, a truncated or a foreign file: refused, exit 2.
     let refuse = |args: &[&str], needle: &str| {
-        let (code, err) = cli(args);
+        let (code, _, err) = common::run(args);
         assert_eq!(code, 2, "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: '{needle}' not in {err}");
         assert!(!err.contains("panicked"));

@@ -1,41 +1,10 @@
 //! The `radiosity` command as a user meets it: outputs of a solve, and every kind of bad input
 //! giving one line naming the file and the problem, exit code 2, never a panic.
 
-use assert_cmd::Command;
+mod common;
+
+use common::{assert_user_error, run};
 use std::path::Path;
-
-fn radiosity() -> Command {
-    let mut c = Command::cargo_bin("radiosity").unwrap();
-    c.env_remove("RUST_BACKTRACE");
-    c
-}
-
-/// Runs and returns (exit code, stdout, stderr).
-fn run(args: &[&str]) -> (i32, String, String) {
-    let out = radiosity().args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// A bad-input failure: exit code 2, no panic, and an error line naming `needle`.
-fn assert_user_error(args: &[&str], needles: &[&str]) {
-    let (code, _, err) = run(args);
-    assert_eq!(code, 2, "args {args:?}: stderr {err}");
-    assert!(!err.contains("panicked"), "panic: {err}");
-    let line = err
-        .lines()
-        .find(|l| l.starts_with("Error:") || l.starts_with("error:"))
-        .unwrap_or_else(|| panic!("no error line in {err}"));
-    for n in needles {
-        assert!(
-            line.to_lowercase().contains(&n.to_lowercase()),
-            "'{n}' not in error line '{line}'"
-        );
-    }
-}
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
     let p = dir.join(name);

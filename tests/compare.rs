@@ -2,7 +2,9 @@
 //! writes its CSV, plots and Markdown. Nothing here is timed: the speedups are measured by the
 //! reproduction (README), not asserted.
 
-use assert_cmd::Command;
+mod common;
+
+use common::radiosity;
 use radiosity::compare::reference;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, MeshOptions};
@@ -10,12 +12,6 @@ use radiosity::scene::{self, LoadOptions};
 use radiosity::solve::error;
 use radiosity::solve::SolveConfig;
 use std::path::Path;
-
-fn radiosity() -> Command {
-    let mut c = Command::cargo_bin("radiosity").unwrap();
-    c.env_remove("RUST_BACKTRACE");
-    c
-}
 
 /// The reference's stated bound holds against a second, independent reference: two tables
 /// with bounds σ₁, σ₂ should differ by about sqrt(σ₁² + σ₂²); the bar is a factor of 2 either

@@ -2,45 +2,17 @@
 //! read back with their crates' readers, and bad solution files refused with one line and exit
 //! code 2, leaving no output behind.
 
-use assert_cmd::Command;
+mod common;
+
+use common::{assert_user_error, run};
 use radiosity::export::solution::{SavedSolution, FORMAT_VERSION};
 use radiosity::false_colour::{BACKGROUND, LEGEND_WIDTH};
 use std::path::{Path, PathBuf};
-
-fn radiosity() -> Command {
-    let mut c = Command::cargo_bin("radiosity").unwrap();
-    c.env_remove("RUST_BACKTRACE");
-    c
-}
-
-/// Runs and returns (exit code, stdout, stderr).
-fn run(args: &[&str]) -> (i32, String, String) {
-    let out = radiosity().args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn ok(args: &[&str]) -> String {
     let (code, out, err) = run(args);
     assert_eq!(code, 0, "{args:?}: {err}");
     out
-}
-
-/// A user error: exit code 2, no panic, one error line holding every needle.
-fn refused(args: &[&str], needles: &[&str]) {
-    let (code, _, err) = run(args);
-    assert_eq!(code, 2, "{args:?}: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-    let line = err
-        .lines()
-        .find(|l| l.starts_with("Error:") || l.starts_with("error:"))
-        .unwrap_or_else(|| panic!("no error line in {err}"));
-    for n in needles {
-        assert!(line.contains(n), "'{n}' not in '{line}'");
-    }
 }
 
 fn s(p: &Path) -> &str {
@@ -145,8 +117,8 @@ fn bad_solution_files_are_refused_with_one_line() {
     let check = |name: &str, bytes: &[u8], needles: &[&str]| {
         let p = dir.path().join(name);
         std::fs::write(&p, bytes).unwrap();
-        refused(&["render", s(&p), "--out", s(&out)], needles);
-        refused(
+        assert_user_error(&["render", s(&p), "--out", s(&out)], needles);
+        assert_user_error(
             &["export", s(&p), "--out", s(&dir.path().join("x.ply"))],
             needles,
         );
@@ -170,7 +142,7 @@ fn bad_solution_files_are_refused_with_one_line() {
     let k = flipped.len() - 7;
     flipped[k] ^= 0xff;
     check("flip.rad", &flipped, &["flip.rad", "damaged"]);
-    refused(
+    assert_user_error(
         &["render", s(&dir.path().join("none.rad")), "--out", s(&out)],
         &["none.rad", "cannot read"],
     );
@@ -178,18 +150,18 @@ fn bad_solution_files_are_refused_with_one_line() {
     let obj = furnace(dir.path());
     let p = dir.path().join("good.rad");
     std::fs::write(&p, &good).unwrap();
-    refused(
+    assert_user_error(
         &["render", s(&p), "--out", s(&out), "--scene", s(&obj)],
         &["good.rad", "another scene"],
     );
     assert!(!out.exists());
     // Formats come from the extension.
-    refused(
+    assert_user_error(
         &["render", s(&p), "--out", "x.jpg"],
         &[".png, .hdr or .exr"],
     );
-    refused(&["export", s(&p), "--out", "x.obj"], &[".ply or .glb"]);
-    refused(
+    assert_user_error(&["export", s(&p), "--out", "x.obj"], &[".ply or .glb"]);
+    assert_user_error(
         &["render", s(&p), "--out", "x.exr", "--false-colour"],
         &["--false-colour"],
     );
@@ -383,7 +355,7 @@ fn solve_reports_in_one_line_or_json_and_refuses_a_bad_save_path() {
     let json = ok(&["solve", "--out", s(&dir.path().join("o")), "--json"]);
     let v: serde_json::Value = serde_json::from_str(&json).unwrap();
     assert_eq!(v["scene"], "cornell-box");
-    refused(
+    assert_user_error(
         &[
             "solve",
             "--out",
@@ -393,7 +365,7 @@ fn solve_reports_in_one_line_or_json_and_refuses_a_bad_save_path() {
         ],
         &["--save", "does not exist"],
     );
-    refused(
+    assert_user_error(
         &[
             "solve",
             "--out",

@@ -4,16 +4,13 @@
 //! `--per-light` keeps no channel.
 mod common;
 
-use assert_cmd::Command;
 use common::*;
 use glam::vec3;
 use radiosity::export::solution::{LightChannel, SavedSolution};
-use radiosity::intersect::embree::EmbreeScene;
-use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::{self, LoadOptions, Scene};
 use radiosity::solve::error::against;
 use radiosity::solve::lights::{groups, GroupBy};
-use radiosity::solve::{self, scalar, MethodKind, Solution, SolveConfig};
+use radiosity::solve::{scalar, MethodKind, SolveConfig};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -22,29 +19,11 @@ fn office() -> Scene {
     scene::load_obj(&path, &LoadOptions::default()).unwrap()
 }
 
-fn mesh_of(scene: &Scene, patch_size: Option<f32>) -> Mesh {
-    mesh::build(
-        scene,
-        &MeshOptions {
-            patch_size,
-            two_sided: false,
-        },
-    )
-}
-
-fn run(scene: &Scene, m: &Mesh, cfg: &SolveConfig) -> Solution {
-    let isect = cfg
-        .method
-        .casts_rays()
-        .then(|| EmbreeScene::build(m, |_| true).unwrap());
-    solve::run(m, &scene.materials, isect.as_ref(), cfg, |_| {}).unwrap()
-}
-
 /// Channels sum to the combined solution, for shooting by rays, by hemi-cube and gathering.
 #[test]
 fn channels_sum_to_the_combined_solution() {
     let scene = office();
-    let m = mesh_of(&scene, Some(0.6));
+    let m = mesh_at(&scene, Some(0.6));
     let g = groups(&scene, &m, GroupBy::Material);
     assert_eq!(g.names, ["light_front", "light_rear"]);
     for method in [
@@ -58,7 +37,7 @@ fn channels_sum_to_the_combined_solution() {
             light_groups: Some(Arc::new(g.clone())),
             ..SolveConfig::default()
         };
-        let sol = run(&scene, &m, &cfg);
+        let sol = solve_mesh(&scene, &m, &cfg);
         assert_eq!(sol.channels.len(), 2);
         for (j, b) in sol.b.iter().enumerate() {
             for (x, &bx) in b.iter().enumerate() {
@@ -78,7 +57,7 @@ fn channels_sum_to_the_combined_solution() {
         }
     }
     // Without --per-light: nothing per light.
-    let sol = run(&scene, &m, &SolveConfig::default());
+    let sol = solve_mesh(&scene, &m, &SolveConfig::default());
     assert!(sol.channels.is_empty());
 }
 
@@ -89,7 +68,7 @@ fn channels_sum_to_the_combined_solution() {
 #[test]
 fn relighting_equals_a_fresh_solve_with_the_weights() {
     let scene = office();
-    let m = mesh_of(&scene, Some(0.6));
+    let m = mesh_at(&scene, Some(0.6));
     let g = groups(&scene, &m, GroupBy::Material);
     let cfg = SolveConfig {
         method: MethodKind::AdaptiveRays,
@@ -97,7 +76,7 @@ fn relighting_equals_a_fresh_solve_with_the_weights() {
         light_groups: Some(Arc::new(g)),
         ..SolveConfig::default()
     };
-    let sol = run(&scene, &m, &cfg);
+    let sol = solve_mesh(&scene, &m, &cfg);
     let relit: Vec<[f64; 3]> = (0..sol.b.len())
         .map(|j| [0, 1, 2].map(|x| 0.0 * sol.channels[0].b[j][x] + 2.0 * sol.channels[1].b[j][x]))
         .collect();
@@ -109,7 +88,7 @@ fn relighting_equals_a_fresh_solve_with_the_weights() {
             _ => {}
         }
     }
-    let fresh = run(
+    let fresh = solve_mesh(
         &fresh_scene,
         &m,
         &SolveConfig {
@@ -155,7 +134,7 @@ fn lights_group_by_material_or_connected_surface() {
     lamp(&mut s, 0.5);
     lamp(&mut s, 1.0); // shares an edge with the first
     lamp(&mut s, 3.0);
-    let m = mesh_of(&s, Some(0.5));
+    let m = mesh_at(&s, Some(0.5));
     let by_mat = groups(&s, &m, GroupBy::Material);
     assert_eq!(by_mat.names, ["lamp"]);
     let by_conn = groups(&s, &m, GroupBy::Connected);
@@ -170,19 +149,6 @@ fn lights_group_by_material_or_connected_surface() {
     assert_eq!(lit.iter().filter(|&&g| g == 1).count(), 1);
 }
 
-fn radiosity(args: &[&str]) -> (i32, String, String) {
-    let out = Command::cargo_bin("radiosity")
-        .unwrap()
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 /// From the command line: solve --per-light --save, relight to PNG and GLB; the saved file
 /// carries the channels; relighting a solution without channels, or naming a light that is
 /// not there, is a clear error with exit code 2 and no output file.
@@ -192,7 +158,7 @@ fn relight_from_the_command_line() {
     let p = |n: &str| dir.path().join(n).display().to_string();
     let office = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/office.obj");
     let office = office.to_str().unwrap();
-    let (code, _, err) = radiosity(&[
+    let (code, _, err) = common::run(&[
         "solve",
         office,
         "--patch-size",
@@ -213,7 +179,7 @@ fn relight_from_the_command_line() {
         .collect();
     assert_eq!(names, ["light_front", "light_rear"]);
     for out in ["r.png", "r.glb"] {
-        let (code, _, err) = radiosity(&[
+        let (code, _, err) = common::run(&[
             "relight",
             &p("o.rad"),
             "--weight",
@@ -226,7 +192,7 @@ fn relight_from_the_command_line() {
         assert_eq!(code, 0, "{err}");
         assert!(Path::new(&p(out)).exists());
     }
-    let (code, _, err) = radiosity(&[
+    let (code, _, err) = common::run(&[
         "relight",
         &p("o.rad"),
         "--weight",
@@ -237,7 +203,7 @@ fn relight_from_the_command_line() {
     assert_eq!(code, 2);
     assert!(err.contains("light_front, light_rear"), "{err}");
     assert!(!Path::new(&p("x.png")).exists());
-    let (code, _, _) = radiosity(&[
+    let (code, _, _) = common::run(&[
         "solve",
         office,
         "--patch-size",
@@ -249,10 +215,10 @@ fn relight_from_the_command_line() {
         "--quiet",
     ]);
     assert_eq!(code, 0);
-    let (code, _, err) = radiosity(&["relight", &p("plain.rad"), "--out", &p("y.png")]);
+    let (code, _, err) = common::run(&["relight", &p("plain.rad"), "--out", &p("y.png")]);
     assert_eq!(code, 2);
     assert!(err.contains("--per-light"), "{err}");
-    let (code, _, err) = radiosity(&[
+    let (code, _, err) = common::run(&[
         "relight",
         &p("o.rad"),
         "--weight",

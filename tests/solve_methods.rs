@@ -4,11 +4,10 @@
 mod common;
 
 use common::*;
-use radiosity::intersect::embree::EmbreeScene;
-use radiosity::mesh::{self, Mesh, MeshOptions};
+use radiosity::mesh::Mesh;
 use radiosity::scene::{self, LoadOptions, Scene};
 use radiosity::solve::gathering::{gauss_seidel, shoot_matrix, FormFactors};
-use radiosity::solve::{self, scalar, MethodKind, Solution, SolveConfig, StopReason};
+use radiosity::solve::{scalar, MethodKind, SolveConfig, StopReason};
 use std::path::Path;
 
 const ALL: [MethodKind; 6] = [
@@ -19,24 +18,6 @@ const ALL: [MethodKind; 6] = [
     MethodKind::AdaptiveHybrid,
     MethodKind::Gathering,
 ];
-
-fn mesh_of(scene: &Scene, patch_size: Option<f32>) -> Mesh {
-    mesh::build(
-        scene,
-        &MeshOptions {
-            patch_size,
-            two_sided: false,
-        },
-    )
-}
-
-fn run(scene: &Scene, m: &Mesh, cfg: &SolveConfig) -> Solution {
-    let isect = cfg
-        .method
-        .casts_rays()
-        .then(|| EmbreeScene::build(m, |_| true).unwrap());
-    solve::run(m, &scene.materials, isect.as_ref(), cfg, |_| {}).unwrap()
-}
 
 fn config(method: MethodKind) -> SolveConfig {
     SolveConfig {
@@ -72,10 +53,10 @@ fn errors(m: &Mesh, b: &[[f64; 3]], reference: &[[f64; 3]]) -> (f64, f64) {
 fn every_method_reaches_e_over_one_minus_rho_in_a_closed_box() {
     let (rho, ke) = (0.5, 1.0 / std::f64::consts::PI);
     let scene = closed_box(1.0, 1.0, 1.0, material("wall", rho, ke));
-    let m = mesh_of(&scene, Some(0.25));
+    let m = mesh_at(&scene, Some(0.25));
     let exact = 1.0 / (1.0 - rho);
     for method in ALL {
-        let sol = run(&scene, &m, &config(method));
+        let sol = solve_mesh(&scene, &m, &config(method));
         let max = sol
             .b
             .iter()
@@ -114,9 +95,9 @@ fn blocks() -> Scene {
 #[test]
 fn all_methods_agree_on_blocks() {
     let scene = blocks();
-    let m = mesh_of(&scene, None);
+    let m = mesh_at(&scene, None);
     assert_eq!(m.patches.len(), 232);
-    let reference = run(
+    let reference = solve_mesh(
         &scene,
         &m,
         &SolveConfig {
@@ -127,7 +108,7 @@ fn all_methods_agree_on_blocks() {
     );
     let mut report = String::new();
     for method in ALL {
-        let sol = run(&scene, &m, &config(method));
+        let sol = solve_mesh(&scene, &m, &config(method));
         let (energy, percent) = errors(&m, &sol.b, &reference.b);
         report += &format!(
             "{}: energy {:.2} %, weighted percent {:.2} %\n",
@@ -155,7 +136,7 @@ fn all_methods_agree_on_blocks() {
 #[test]
 fn gathering_and_shooting_agree_on_blocks_form_factors() {
     let scene = blocks();
-    let m = mesh_of(&scene, None);
+    let m = mesh_at(&scene, None);
     let ff = FormFactors::by_hemicube(&m, 64, 5);
     let area: Vec<f64> = m.patches.iter().map(|p| p.area).collect();
     let mat = |p: &radiosity::mesh::Patch| &scene.materials[p.material as usize];
@@ -179,7 +160,7 @@ fn gathering_and_shooting_agree_on_blocks_form_factors() {
 #[test]
 fn methods_report_what_they_did_and_do_not_depend_on_threads() {
     let scene = blocks();
-    let m = mesh_of(&scene, None);
+    let m = mesh_at(&scene, None);
     for method in ALL {
         // The hybrid's measured switch depends on timings: replay a fixed one.
         let cfg = SolveConfig {
@@ -190,12 +171,12 @@ fn methods_report_what_they_did_and_do_not_depend_on_threads() {
             .num_threads(1)
             .build()
             .unwrap()
-            .install(|| run(&scene, &m, &cfg));
+            .install(|| solve_mesh(&scene, &m, &cfg));
         let two = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .build()
             .unwrap()
-            .install(|| run(&scene, &m, &cfg));
+            .install(|| solve_mesh(&scene, &m, &cfg));
         assert_eq!(one.b, two.b, "{}", method.name());
         let s = &one.stats;
         match method {
@@ -218,8 +199,8 @@ fn methods_report_what_they_did_and_do_not_depend_on_threads() {
 #[test]
 fn the_hybrid_switches_on_measured_costs() {
     let scene = blocks();
-    let m = mesh_of(&scene, None);
-    let sol = run(&scene, &m, &config(MethodKind::AdaptiveHybrid));
+    let m = mesh_at(&scene, None);
+    let sol = solve_mesh(&scene, &m, &config(MethodKind::AdaptiveHybrid));
     let s = &sol.stats;
     let sw = s.switch.expect("the hybrid switched to rays");
     assert!(!sw.forced);
@@ -236,8 +217,8 @@ fn the_hybrid_switches_on_measured_costs() {
 #[test]
 fn the_error_estimate_tracks_the_true_error_within_a_factor_of_two() {
     let scene = blocks();
-    let m = mesh_of(&scene, None);
-    let reference = run(
+    let m = mesh_at(&scene, None);
+    let reference = solve_mesh(
         &scene,
         &m,
         &SolveConfig {
@@ -252,7 +233,7 @@ fn the_error_estimate_tracks_the_true_error_within_a_factor_of_two() {
             reference: Some(reference.clone()),
             ..config(method)
         };
-        let sol = run(&scene, &m, &cfg);
+        let sol = solve_mesh(&scene, &m, &cfg);
         assert!(sol.stats.trace.len() >= 5, "{}", method.name());
         for p in &sol.stats.trace {
             let e = p.error.expect("error against the reference");
