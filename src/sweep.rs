@@ -313,22 +313,24 @@ fn write_outputs(job: &SweepJob, rows: &[SweepRow]) -> Result<(), Error> {
             .collect()
     };
     if rows.len() >= 2 {
-        let png = plot::draw(
-            "Solve time against scene size",
-            "patches",
-            "solve time (s)",
-            &curves(&|r| r.solve_s),
-            true,
-        )?;
-        write_atomic(&job.out.join("time.png"), |w| w.write_all(&png))?;
-        let png = plot::draw(
-            "Peak memory against scene size",
-            "patches",
-            "peak resident set (MiB)",
-            &curves(&|r| r.peak_mib),
-            true,
-        )?;
-        write_atomic(&job.out.join("memory.png"), |w| w.write_all(&png))?;
+        let plots: [(&str, &str, &str, &dyn Fn(&SweepRow) -> f64); 2] = [
+            (
+                "time.png",
+                "Solve time against scene size",
+                "solve time (s)",
+                &|r| r.solve_s,
+            ),
+            (
+                "memory.png",
+                "Peak memory against scene size",
+                "peak resident set (MiB)",
+                &|r| r.peak_mib,
+            ),
+        ];
+        for (file, title, y, f) in plots {
+            let png = plot::draw(title, "patches", y, &curves(f), true)?;
+            write_atomic(&job.out.join(file), |w| w.write_all(&png))?;
+        }
     }
     Ok(())
 }
