@@ -313,22 +313,28 @@ fn write_outputs(job: &SweepJob, rows: &[SweepRow]) -> Result<(), Error> {
             .collect()
     };
     if rows.len() >= 2 {
-        let plots: [(&str, &str, &str, &dyn Fn(&SweepRow) -> f64); 2] = [
+        type Plot = (
+            &'static str,
+            &'static str,
+            &'static str,
+            fn(&SweepRow) -> f64,
+        );
+        let plots: [Plot; 2] = [
             (
                 "time.png",
                 "Solve time against scene size",
                 "solve time (s)",
-                &|r| r.solve_s,
+                |r| r.solve_s,
             ),
             (
                 "memory.png",
                 "Peak memory against scene size",
                 "peak resident set (MiB)",
-                &|r| r.peak_mib,
+                |r| r.peak_mib,
             ),
         ];
         for (file, title, y, f) in plots {
-            let png = plot::draw(title, "patches", y, &curves(f), true)?;
+            let png = plot::draw(title, "patches", y, &curves(&f), true)?;
             write_atomic(&job.out.join(file), |w| w.write_all(&png))?;
         }
     }
