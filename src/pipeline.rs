@@ -347,10 +347,9 @@ fn solve_into(
             let path = path.clone();
             cfg.checkpoint = Some(solve::checkpoint::Sink {
                 every: std::time::Duration::from_secs_f64(job.checkpoint_every),
+                key: key.clone(),
                 write: std::sync::Arc::new(move |snap: &solve::checkpoint::Snapshot| {
-                    let mut snap_keyed = snap.clone();
-                    snap_keyed.header.key = key.clone();
-                    let bytes = snap_keyed.to_bytes();
+                    let bytes = snap.to_bytes();
                     write_atomic(&path, |w| w.write_all(&bytes)).map_err(|e| e.to_string())
                 }),
             });
@@ -361,8 +360,7 @@ fn solve_into(
                 .map_err(|e| Error::Invalid(format!("--resume {what}: cannot read it ({e})")))?;
             let snap =
                 solve::checkpoint::Snapshot::from_bytes(&what, &bytes).map_err(Error::Invalid)?;
-            snap.check_key(&what, &checkpoint_key(job, &scene, &m))
-                .map_err(Error::Invalid)?;
+            snap.check_key(&what, &key).map_err(Error::Invalid)?;
             log(&format!(
                 "resuming from {what}: {} shots, {:.1} s done",
                 snap.header.shots, snap.header.elapsed

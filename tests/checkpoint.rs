@@ -38,6 +38,7 @@ fn recording_sink() -> (Sink, Arc<Mutex<Vec<Snapshot>>>) {
     let k = kept.clone();
     let sink = Sink {
         every: Duration::ZERO,
+        key: "test".into(),
         write: Arc::new(move |s: &Snapshot| {
             k.lock().unwrap().push(s.clone());
             Ok(())
@@ -83,6 +84,7 @@ fn resumed_runs_equal_uninterrupted_ones() {
         let mid = &snaps[snaps.len() / 2];
         let snap = Snapshot::from_bytes("mid", &mid.to_bytes()).unwrap();
         assert!(snap.header.shots > 0);
+        assert_eq!(snap.header.key, "test", "the sink's key is in every snapshot");
         let resumed = run(
             &s,
             &m,
@@ -111,6 +113,7 @@ fn an_interrupt_stops_at_a_safe_point_with_a_checkpoint() {
     let (k, f) = (kept.clone(), flag.clone());
     let sink = Sink {
         every: Duration::ZERO,
+        key: "test".into(),
         write: Arc::new(move |snap: &Snapshot| {
             let mut v = k.lock().unwrap();
             v.push(snap.clone());

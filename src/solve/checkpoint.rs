@@ -32,6 +32,8 @@ pub type WriteFn = dyn Fn(&Snapshot) -> Result<(), String> + Send + Sync;
 #[derive(Clone)]
 pub struct Sink {
     pub every: Duration,
+    /// What a resumed run must match (the scene and the settings); stored in every snapshot.
+    pub key: String,
     pub write: Arc<WriteFn>,
 }
 

@@ -430,6 +430,7 @@ pub fn shoot<I: Intersector>(
             if let Some(sink) = &cfg.checkpoint {
                 if interrupted || elapsed >= next_checkpoint {
                     let snap = st.snapshot(Header {
+                        key: sink.key.clone(),
                         elapsed,
                         shots: stats.shots,
                         waves: stats.waves,
