@@ -501,9 +501,6 @@ pub fn shoot<I: Intersector>(
         // Trace points at geometric steps of time and of shots (even spacing on the log-log
         // plots of error against time).
         if elapsed >= next_trace || stats.shots >= next_trace_shots {
-            let flying = pending
-                .as_ref()
-                .map_or(0.0, |p| p.wave.iter().map(|s| scalar(&s.phi)).sum::<f64>());
             st.record(
                 &mut stats,
                 elapsed,
