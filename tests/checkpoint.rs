@@ -84,7 +84,10 @@ fn resumed_runs_equal_uninterrupted_ones() {
         let mid = &snaps[snaps.len() / 2];
         let snap = Snapshot::from_bytes("mid", &mid.to_bytes()).unwrap();
         assert!(snap.header.shots > 0);
-        assert_eq!(snap.header.key, "test", "the sink's key is in every snapshot");
+        assert_eq!(
+            snap.header.key, "test",
+            "the sink's key is in every snapshot"
+        );
         let resumed = run(
             &s,
             &m,
