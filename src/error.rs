@@ -44,3 +44,9 @@ impl Error {
         }
     }
 }
+
+impl From<crate::settings::Invalid> for Error {
+    fn from(e: crate::settings::Invalid) -> Error {
+        Error::Invalid(e.0)
+    }
+}

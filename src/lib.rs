@@ -26,6 +26,7 @@ pub mod render;
 pub mod report;
 pub mod sample;
 pub mod scene;
+pub mod settings;
 pub mod shot_bench;
 pub mod solve;
 pub mod sweep;

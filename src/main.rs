@@ -10,7 +10,7 @@ use radiosity::mesh::MeshOptions;
 use radiosity::pipeline::{self, CameraSpec, SceneSource, SolveJob};
 use radiosity::render::RenderOptions;
 use radiosity::scene::LoadOptions;
-use radiosity::solve::{MethodKind, SolveConfig};
+use radiosity::solve::{MethodKind, SolveSettings};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -762,14 +762,14 @@ impl SceneArgs {
 }
 
 impl SolverArgs {
-    fn config(&self) -> Result<SolveConfig, radiosity::Error> {
+    fn config(&self) -> Result<SolveSettings, radiosity::Error> {
         let max_time = match self.max_time {
             Some(t) if !(t > 0.0 && t.is_finite()) => {
                 return Err(radiosity::Error::Invalid(format!(
                     "--max-time must be a positive number of seconds, got {t}"
                 )))
             }
-            t => t.map(Duration::from_secs_f64),
+            t => t,
         };
         if let Some(c) = self.energy_per_ray {
             if !(c > 0.0 && c.is_finite()) {
@@ -778,7 +778,7 @@ impl SolverArgs {
                 )));
             }
         }
-        Ok(SolveConfig {
+        Ok(SolveSettings {
             seed: self.seed,
             tolerance: self.tolerance,
             energy_per_ray: self.energy_per_ray,
@@ -790,7 +790,7 @@ impl SolverArgs {
             hemicube_n: self.hemicube_n,
             gather_cap_mib: self.gather_cap_mib,
             switch_at: self.switch_at,
-            ..SolveConfig::default()
+            ..SolveSettings::default()
         })
     }
 }
@@ -969,11 +969,11 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 source: source(a.scene),
                 load: a.scene_args.load(),
                 mesh: a.scene_args.mesh(),
-                solve: SolveConfig {
+                solve: SolveSettings {
                     seed: a.seed,
                     tolerance: a.tolerance,
                     stop_fraction: a.stop,
-                    ..SolveConfig::default()
+                    ..SolveSettings::default()
                 },
                 intersector: a.intersector.into(),
                 out: a.out,
@@ -1010,20 +1010,20 @@ fn run(cli: Cli) -> Result<(), radiosity::Error> {
                 mesh: a.scene_args.mesh(),
                 methods: a.methods.into_iter().map(MethodKind::from).collect(),
                 budget: Duration::from_secs_f64(a.budget),
-                solve: SolveConfig {
+                solve: SolveSettings {
                     seed: a.seed,
                     tolerance: a.tolerance,
                     stop_fraction: a.stop,
                     hemicube_n: a.hemicube_n,
                     gather_cap_mib: a.gather_cap_mib,
-                    ..SolveConfig::default()
+                    ..SolveSettings::default()
                 },
                 reference: a.reference,
-                reference_solve: SolveConfig {
+                reference_solve: SolveSettings {
                     seed: a.seed.wrapping_add(1_000_003),
                     tolerance: a.reference_tolerance,
                     stop_fraction: a.reference_stop,
-                    ..SolveConfig::default()
+                    ..SolveSettings::default()
                 },
                 intersector: a.intersector.into(),
                 levels: a.levels,

@@ -10,7 +10,7 @@ use crate::progress::Progress;
 use crate::render::{self, Camera, RenderOptions};
 use crate::report::{self, EnergyReport, Summary, Timings};
 use crate::scene::{self, LoadOptions, Scene};
-use crate::solve::{self, MethodKind, SolveConfig, TracePoint};
+use crate::solve::{self, MethodKind, SolveSettings, TracePoint};
 use crate::Error;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
@@ -89,7 +89,7 @@ pub struct SolveJob {
     pub source: SceneSource,
     pub load: LoadOptions,
     pub mesh: MeshOptions,
-    pub solve: SolveConfig,
+    pub solve: SolveSettings,
     pub out: PathBuf,
     /// `--intersector`.
     pub intersector: IntersectorKind,
@@ -143,7 +143,7 @@ pub fn validate(job: &SolveJob) -> Result<(), Error> {
             job.checkpoint_every
         )));
     }
-    s.check().map_err(Error::Invalid)?;
+    s.check()?;
     if let Some(ps) = job.mesh.patch_size {
         if !(ps > 0.0 && ps.is_finite()) {
             return Err(Error::Invalid(format!(
@@ -327,7 +327,8 @@ fn solve_into(
         log(&format!("intersector {}: {}", isect.name(), chosen.reason));
     }
 
-    let mut cfg = job.solve.clone();
+    let cfg = &job.solve;
+    let mut hooks = solve::RunHooks::default();
     if let Some(by) = job.per_light {
         let g = solve::lights::groups(&scene, &m, by);
         log(&format!(
@@ -335,17 +336,17 @@ fn solve_into(
             g.len(),
             g.names.join(", ")
         ));
-        cfg.light_groups = Some(std::sync::Arc::new(g));
+        hooks.light_groups = Some(std::sync::Arc::new(g));
     }
     if let Some(path) = &job.reference {
-        cfg.reference = Some(std::sync::Arc::new(load_reference(path, &m)?));
+        hooks.reference = Some(std::sync::Arc::new(load_reference(path, &m)?));
     }
-    cfg.interrupt = job.interrupt.clone();
+    hooks.interrupt = job.interrupt.clone();
     if job.checkpoint.is_some() || job.resume.is_some() {
         let key = checkpoint_key(job, &scene, &m);
         if let Some(path) = &job.checkpoint {
             let path = path.clone();
-            cfg.checkpoint = Some(solve::checkpoint::Sink {
+            hooks.checkpoint = Some(solve::checkpoint::Sink {
                 every: std::time::Duration::from_secs_f64(job.checkpoint_every),
                 key: key.clone(),
                 write: std::sync::Arc::new(move |snap: &solve::checkpoint::Snapshot| {
@@ -365,7 +366,7 @@ fn solve_into(
                 "resuming from {what}: {} shots, {:.1} s done",
                 snap.header.shots, snap.header.elapsed
             ));
-            cfg.resume = Some(std::sync::Arc::new(snap));
+            hooks.resume = Some(std::sync::Arc::new(snap));
         }
     }
     let t = Instant::now();
@@ -374,7 +375,8 @@ fn solve_into(
         &m,
         &scene.materials,
         isect.as_ref(),
-        &cfg,
+        cfg,
+        &hooks,
         |p: &TracePoint| progress.solve_wave(p),
     )
     .map_err(|source| Error::Solve {
@@ -667,13 +669,13 @@ pub fn bench_rays(
     source: &SceneSource,
     load: &LoadOptions,
     mesh_opts: &MeshOptions,
-    cfg: &SolveConfig,
+    cfg: &SolveSettings,
     kind: IntersectorKind,
     raw_rays: u64,
     min_seconds: f64,
 ) -> Result<RayBench, Error> {
     // The solver's rays are what is measured: the ray shooter, whatever --method says.
-    let cfg = &SolveConfig {
+    let cfg = &SolveSettings {
         method: solve::MethodKind::AdaptiveRays,
         ..cfg.clone()
     };
@@ -696,7 +698,7 @@ pub fn bench_rays(
         if solves > 0 && (solver_s >= min_seconds || solves >= 100) {
             break;
         }
-        let round = SolveConfig {
+        let round = SolveSettings {
             seed: cfg.seed.wrapping_add(solves as u64),
             ..cfg.clone()
         };

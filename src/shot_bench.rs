@@ -17,7 +17,7 @@ use crate::pipeline::{load_scene, SceneSource};
 use crate::sample::hemicube::{Hemicube, HemicubeBuffer};
 use crate::sample::Frame;
 use crate::scene::LoadOptions;
-use crate::solve::{self, progressive, MethodKind, SolveConfig, SwitchInfo};
+use crate::solve::{self, progressive, MethodKind, SolveSettings, SwitchInfo};
 use crate::Error;
 use serde::Serialize;
 use std::time::Instant;
@@ -111,7 +111,7 @@ pub fn bench_shots(
     source: &SceneSource,
     load: &LoadOptions,
     mesh_opts: &MeshOptions,
-    cfg: &SolveConfig,
+    cfg: &SolveSettings,
     ns: &[usize],
     shooters: usize,
 ) -> Result<ShotBench, Error> {
@@ -168,7 +168,7 @@ pub fn bench_shots(
         });
     }
 
-    let hybrid = SolveConfig {
+    let hybrid = SolveSettings {
         method: MethodKind::AdaptiveHybrid,
         ..cfg.clone()
     };

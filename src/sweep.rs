@@ -17,7 +17,7 @@ use crate::intersect::select::{self, IntersectorKind};
 use crate::intersect::Intersector;
 use crate::mesh::MeshOptions;
 use crate::scene::{self, LoadOptions};
-use crate::solve::{self, MethodKind, SolveConfig};
+use crate::solve::{self, MethodKind, SolveSettings};
 use crate::Error;
 use serde::Serialize;
 use std::io::Write;
@@ -30,7 +30,7 @@ pub struct SweepJob {
     /// Target patch counts.
     pub sizes: Vec<usize>,
     pub methods: Vec<MethodKind>,
-    pub cfg: SolveConfig,
+    pub cfg: SolveSettings,
     pub intersector: IntersectorKind,
     /// Output folder.
     pub out: PathBuf,
@@ -176,15 +176,21 @@ fn run_one(
     };
     let build_s = t.elapsed().as_secs_f64();
     let (after, _) = rss_kib();
-    let cfg = SolveConfig {
+    let cfg = SolveSettings {
         method,
         ..job.cfg.clone()
     };
-    let sol = solve::run(&m, &scene.materials, isect.as_ref(), &cfg, |_| {}).map_err(|source| {
-        Error::Solve {
-            scene: format!("generated building of {} patches", m.patches.len()),
-            source,
-        }
+    let sol = solve::run(
+        &m,
+        &scene.materials,
+        isect.as_ref(),
+        &cfg,
+        &Default::default(),
+        |_| {},
+    )
+    .map_err(|source| Error::Solve {
+        scene: format!("generated building of {} patches", m.patches.len()),
+        source,
     })?;
     let (_, peak) = rss_kib();
     let embree = (after - before).max(0.0);

@@ -8,7 +8,7 @@ use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::{self, LoadOptions, Scene};
 use radiosity::solve::checkpoint::{Sink, Snapshot};
-use radiosity::solve::{self, MethodKind, Solution, SolveConfig, StopReason};
+use radiosity::solve::{self, MethodKind, RunHooks, Solution, SolveSettings, StopReason};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
@@ -27,9 +27,13 @@ fn office() -> (Scene, Mesh) {
     (s, m)
 }
 
-fn run(s: &Scene, m: &Mesh, cfg: &SolveConfig) -> Solution {
+fn run(s: &Scene, m: &Mesh, cfg: &SolveSettings) -> Solution {
+    run_with(s, m, cfg, &RunHooks::default())
+}
+
+fn run_with(s: &Scene, m: &Mesh, cfg: &SolveSettings, hooks: &RunHooks) -> Solution {
     let isect = EmbreeScene::build(m, |_| true).unwrap();
-    solve::solve(m, &s.materials, &isect, cfg, |_| {}).unwrap()
+    solve::run(m, &s.materials, Some(&isect), cfg, hooks, |_| {}).unwrap()
 }
 
 /// Every safe point's snapshot, kept in memory.
@@ -55,20 +59,21 @@ fn resumed_runs_equal_uninterrupted_ones() {
         (MethodKind::AdaptiveHemicube, None),
         (MethodKind::AdaptiveHybrid, Some(12)),
     ] {
-        let base = SolveConfig {
+        let base = SolveSettings {
             method,
             switch_at,
             tolerance: 0.03,
-            ..SolveConfig::default()
+            ..SolveSettings::default()
         };
         let plain = run(&s, &m, &base);
         let (sink, kept) = recording_sink();
-        let with = run(
+        let with = run_with(
             &s,
             &m,
-            &SolveConfig {
+            &base,
+            &RunHooks {
                 checkpoint: Some(sink),
-                ..base.clone()
+                ..RunHooks::default()
             },
         );
         // Checkpointing does not change the run.
@@ -88,12 +93,13 @@ fn resumed_runs_equal_uninterrupted_ones() {
             snap.header.key, "test",
             "the sink's key is in every snapshot"
         );
-        let resumed = run(
+        let resumed = run_with(
             &s,
             &m,
-            &SolveConfig {
+            &base,
+            &RunHooks {
                 resume: Some(Arc::new(snap)),
-                ..base.clone()
+                ..RunHooks::default()
             },
         );
         assert_eq!(resumed.b, plain.b, "{}", method.name());
@@ -105,10 +111,10 @@ fn resumed_runs_equal_uninterrupted_ones() {
 #[test]
 fn an_interrupt_stops_at_a_safe_point_with_a_checkpoint() {
     let (s, m) = office();
-    let base = SolveConfig {
+    let base = SolveSettings {
         method: MethodKind::AdaptiveRays,
         tolerance: 0.03,
-        ..SolveConfig::default()
+        ..SolveSettings::default()
     };
     let plain = run(&s, &m, &base);
     let flag = Arc::new(AtomicBool::new(false));
@@ -127,24 +133,26 @@ fn an_interrupt_stops_at_a_safe_point_with_a_checkpoint() {
             Ok(())
         }),
     };
-    let stopped = run(
+    let stopped = run_with(
         &s,
         &m,
-        &SolveConfig {
+        &base,
+        &RunHooks {
             checkpoint: Some(sink),
             interrupt: Some(flag),
-            ..base.clone()
+            ..RunHooks::default()
         },
     );
     assert_eq!(stopped.stats.stop_reason, Some(StopReason::Interrupted));
     assert!(stopped.stats.energy.relative_residual() < 1e-9);
     let last = kept.lock().unwrap().last().unwrap().clone();
-    let resumed = run(
+    let resumed = run_with(
         &s,
         &m,
-        &SolveConfig {
+        &base,
+        &RunHooks {
             resume: Some(Arc::new(last)),
-            ..base
+            ..RunHooks::default()
         },
     );
     assert_eq!(resumed.b, plain.b);

@@ -10,7 +10,7 @@ use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::{self, LoadOptions};
 use radiosity::solve::error;
-use radiosity::solve::SolveConfig;
+use radiosity::solve::SolveSettings;
 use std::path::Path;
 
 /// The reference's stated bound holds against a second, independent reference: two tables
@@ -29,11 +29,11 @@ fn the_references_bound_holds_against_an_independent_reference() {
     );
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let solve = |seed| {
-        let cfg = SolveConfig {
+        let cfg = SolveSettings {
             seed,
             tolerance: 0.01,
             stop_fraction: 1e-5,
-            ..SolveConfig::default()
+            ..SolveSettings::default()
         };
         reference::build(&m, &scene.materials, &isect, &cfg).unwrap()
     };

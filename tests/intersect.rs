@@ -796,7 +796,7 @@ fn selection_builds_only_what_the_scene_needs() {
 #[test]
 fn solves_through_each_intersector_agree() {
     use radiosity::intersect::select::{AnyIntersector, IntersectorKind};
-    use radiosity::solve::{self, SolveConfig};
+    use radiosity::solve::{self, SolveSettings};
     // blocks (4 skew patches): Embree and the hybrid; hallway (all axial, at 1 m patches to
     // stay quick): Embree, the merge and the hybrid.
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
@@ -824,9 +824,9 @@ fn solves_through_each_intersector_agree() {
                 ..Default::default()
             },
         );
-        let cfg = SolveConfig {
+        let cfg = SolveSettings {
             tolerance: 0.1,
-            ..SolveConfig::default()
+            ..SolveSettings::default()
         };
         let solve_with = |k: IntersectorKind| {
             let i = AnyIntersector::build(&m, k).unwrap();

@@ -10,7 +10,7 @@ use radiosity::export::solution::{LightChannel, SavedSolution};
 use radiosity::scene::{self, LoadOptions, Scene};
 use radiosity::solve::error::against;
 use radiosity::solve::lights::{groups, GroupBy};
-use radiosity::solve::{scalar, MethodKind, SolveConfig};
+use radiosity::solve::{scalar, MethodKind, RunHooks, SolveSettings};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -31,13 +31,16 @@ fn channels_sum_to_the_combined_solution() {
         MethodKind::AdaptiveHemicube,
         MethodKind::Gathering,
     ] {
-        let cfg = SolveConfig {
+        let cfg = SolveSettings {
             method,
             hemicube_n: 40,
-            light_groups: Some(Arc::new(g.clone())),
-            ..SolveConfig::default()
+            ..SolveSettings::default()
         };
-        let sol = solve_mesh(&scene, &m, &cfg);
+        let hooks = RunHooks {
+            light_groups: Some(Arc::new(g.clone())),
+            ..RunHooks::default()
+        };
+        let sol = solve_mesh_with(&scene, &m, &cfg, &hooks);
         assert_eq!(sol.channels.len(), 2);
         for (j, b) in sol.b.iter().enumerate() {
             for (x, &bx) in b.iter().enumerate() {
@@ -57,7 +60,7 @@ fn channels_sum_to_the_combined_solution() {
         }
     }
     // Without --per-light: nothing per light.
-    let sol = solve_mesh(&scene, &m, &SolveConfig::default());
+    let sol = solve_mesh(&scene, &m, &SolveSettings::default());
     assert!(sol.channels.is_empty());
 }
 
@@ -70,13 +73,16 @@ fn relighting_equals_a_fresh_solve_with_the_weights() {
     let scene = office();
     let m = mesh_at(&scene, Some(0.6));
     let g = groups(&scene, &m, GroupBy::Material);
-    let cfg = SolveConfig {
+    let cfg = SolveSettings {
         method: MethodKind::AdaptiveRays,
         tolerance: 0.02,
-        light_groups: Some(Arc::new(g)),
-        ..SolveConfig::default()
+        ..SolveSettings::default()
     };
-    let sol = solve_mesh(&scene, &m, &cfg);
+    let hooks = RunHooks {
+        light_groups: Some(Arc::new(g)),
+        ..RunHooks::default()
+    };
+    let sol = solve_mesh_with(&scene, &m, &cfg, &hooks);
     let relit: Vec<[f64; 3]> = (0..sol.b.len())
         .map(|j| [0, 1, 2].map(|x| 0.0 * sol.channels[0].b[j][x] + 2.0 * sol.channels[1].b[j][x]))
         .collect();
@@ -91,8 +97,7 @@ fn relighting_equals_a_fresh_solve_with_the_weights() {
     let fresh = solve_mesh(
         &fresh_scene,
         &m,
-        &SolveConfig {
-            light_groups: None,
+        &SolveSettings {
             seed: 2,
             ..cfg.clone()
         },

@@ -9,7 +9,7 @@ use radiosity::intersect::embree::EmbreeScene;
 use radiosity::intersect::Intersector;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::Scene;
-use radiosity::solve::{self, scalar, MethodKind, Solution, SolveConfig, StopReason};
+use radiosity::solve::{self, scalar, MethodKind, Solution, SolveSettings, StopReason};
 
 fn mesh_of(scene: &Scene, patch_size: f32) -> Mesh {
     mesh::build(
@@ -21,7 +21,7 @@ fn mesh_of(scene: &Scene, patch_size: f32) -> Mesh {
     )
 }
 
-fn run<I: Intersector>(scene: &Scene, m: &Mesh, isect: &I, cfg: &SolveConfig) -> Solution {
+fn run<I: Intersector>(scene: &Scene, m: &Mesh, isect: &I, cfg: &SolveSettings) -> Solution {
     solve::solve(m, &scene.materials, isect, cfg, |_| {}).unwrap()
 }
 
@@ -99,7 +99,7 @@ fn two_squares(parallel: bool) -> Scene {
 /// F_ab estimated as the share of a's flux that b absorbs, from one shot of `rays` rays.
 fn form_factor<I: Intersector>(scene: &Scene, m: &Mesh, isect: &I, rays: f64) -> f64 {
     let emitted = std::f64::consts::PI; // E = π·Ke = π over 1 m²
-    let cfg = SolveConfig {
+    let cfg = SolveSettings {
         energy_per_ray: Some(emitted / rays),
         ..ray_config()
     };
@@ -143,7 +143,7 @@ fn no_ray_escapes_a_closed_box() {
     let m = mesh_of(&scene, 0.09);
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let emitted: f64 = m.patches.iter().map(|p| p.area).sum::<f64>() * std::f64::consts::PI;
-    let cfg = SolveConfig {
+    let cfg = SolveSettings {
         // About 10⁶ rays in all: the emitted flux / C, over (1 − ρ) for the bounces, and the
         // stop criterion cuts the tail.
         energy_per_ray: Some(emitted / (1.0e6 * 0.45)),
@@ -166,7 +166,7 @@ fn result_does_not_depend_on_thread_count() {
     let scene = closed_box(1.0, 0.8, 1.2, material("wall", 0.7, 0.3));
     let m = mesh_of(&scene, 0.1);
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
-    let cfg = SolveConfig {
+    let cfg = SolveSettings {
         seed: 42,
         ..ray_config()
     };
@@ -186,7 +186,7 @@ fn result_does_not_depend_on_thread_count() {
         &scene,
         &m,
         &isect,
-        &SolveConfig {
+        &SolveSettings {
             seed: 43,
             ..cfg.clone()
         },
@@ -195,9 +195,9 @@ fn result_does_not_depend_on_thread_count() {
 }
 
 /// The ray shooter's settings: these tests count rays.
-fn ray_config() -> SolveConfig {
-    SolveConfig {
+fn ray_config() -> SolveSettings {
+    SolveSettings {
         method: MethodKind::AdaptiveRays,
-        ..SolveConfig::default()
+        ..SolveSettings::default()
     }
 }

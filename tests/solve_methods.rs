@@ -7,7 +7,7 @@ use common::*;
 use radiosity::mesh::Mesh;
 use radiosity::scene::{self, LoadOptions, Scene};
 use radiosity::solve::gathering::{gauss_seidel, shoot_matrix, FormFactors};
-use radiosity::solve::{scalar, MethodKind, SolveConfig, StopReason};
+use radiosity::solve::{scalar, MethodKind, RunHooks, SolveSettings, StopReason};
 use std::path::Path;
 
 const ALL: [MethodKind; 6] = [
@@ -19,12 +19,12 @@ const ALL: [MethodKind; 6] = [
     MethodKind::Gathering,
 ];
 
-fn config(method: MethodKind) -> SolveConfig {
-    SolveConfig {
+fn config(method: MethodKind) -> SolveSettings {
+    SolveSettings {
         method,
         // Uniform hemi-cubes at the paper's Table 1 resolution.
         hemicube_n: 100,
-        ..SolveConfig::default()
+        ..SolveSettings::default()
     }
 }
 
@@ -100,7 +100,7 @@ fn all_methods_agree_on_blocks() {
     let reference = solve_mesh(
         &scene,
         &m,
-        &SolveConfig {
+        &SolveSettings {
             tolerance: 0.01,
             seed: 99,
             ..config(MethodKind::AdaptiveRays)
@@ -163,7 +163,7 @@ fn methods_report_what_they_did_and_do_not_depend_on_threads() {
     let m = mesh_at(&scene, None);
     for method in ALL {
         // The hybrid's measured switch depends on timings: replay a fixed one.
-        let cfg = SolveConfig {
+        let cfg = SolveSettings {
             switch_at: (method == MethodKind::AdaptiveHybrid).then_some(4),
             ..config(method)
         };
@@ -221,7 +221,7 @@ fn the_error_estimate_tracks_the_true_error_within_a_factor_of_two() {
     let reference = solve_mesh(
         &scene,
         &m,
-        &SolveConfig {
+        &SolveSettings {
             tolerance: 0.0025,
             seed: 77,
             ..config(MethodKind::AdaptiveRays)
@@ -229,11 +229,11 @@ fn the_error_estimate_tracks_the_true_error_within_a_factor_of_two() {
     );
     let reference = std::sync::Arc::new(reference.b);
     for method in ALL {
-        let cfg = SolveConfig {
+        let hooks = RunHooks {
             reference: Some(reference.clone()),
-            ..config(method)
+            ..RunHooks::default()
         };
-        let sol = solve_mesh(&scene, &m, &cfg);
+        let sol = solve_mesh_with(&scene, &m, &config(method), &hooks);
         assert!(sol.stats.trace.len() >= 5, "{}", method.name());
         for p in &sol.stats.trace {
             let e = p.error.expect("error against the reference");

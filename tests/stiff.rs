@@ -9,9 +9,9 @@ use glam::vec3;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::Scene;
-use radiosity::solve::{self, scalar, MethodKind, Solution, SolveConfig, StopReason};
+use radiosity::solve::{self, scalar, MethodKind, Solution, SolveSettings, StopReason};
 
-fn solve_scene(scene: &Scene, patch_size: f32, cfg: &SolveConfig) -> Solution {
+fn solve_scene(scene: &Scene, patch_size: f32, cfg: &SolveSettings) -> Solution {
     let m = mesh::build(
         scene,
         &MeshOptions {
@@ -67,10 +67,10 @@ fn furnace_near_reflectance_one() {
             1.0,
             material("wall", rho, 1.0 / std::f64::consts::PI),
         );
-        let cfg = SolveConfig {
+        let cfg = SolveSettings {
             method: MethodKind::AdaptiveRays,
             tolerance: 0.0025,
-            ..SolveConfig::default()
+            ..SolveSettings::default()
         };
         let sol = solve_scene(&scene, 0.5, &cfg);
         let what = format!("rho {rho}");
@@ -96,10 +96,10 @@ fn furnace_near_reflectance_one() {
     }
 }
 
-fn rays() -> SolveConfig {
-    SolveConfig {
+fn rays() -> SolveSettings {
+    SolveSettings {
         method: MethodKind::AdaptiveRays,
-        ..SolveConfig::default()
+        ..SolveSettings::default()
     }
 }
 

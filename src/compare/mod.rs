@@ -18,7 +18,7 @@ use crate::mesh::MeshOptions;
 use crate::pipeline::{load_reference, load_scene, SceneSource};
 use crate::scene::LoadOptions;
 use crate::solve::error::ErrorMetrics;
-use crate::solve::{self, MethodKind, SolveConfig, StopReason, SwitchInfo, TracePoint};
+use crate::solve::{self, MethodKind, SolveSettings, StopReason, SwitchInfo, TracePoint};
 use crate::Error;
 use reference::Reference;
 use std::path::{Path, PathBuf};
@@ -32,7 +32,7 @@ pub struct ReferenceJob {
     pub load: LoadOptions,
     pub mesh: MeshOptions,
     /// Seed, tolerance and stop fraction of the reference (its method is ignored).
-    pub solve: SolveConfig,
+    pub solve: SolveSettings,
     pub intersector: IntersectorKind,
     pub out: PathBuf,
 }
@@ -53,7 +53,7 @@ struct ReferenceSummary<'a> {
 /// `radiosity reference`: solves the reference, writes `patches.csv` and `summary.json` into
 /// `job.out`, and fails ([`Error::Failed`], after writing) if the check of its bound fails.
 pub fn run_reference(job: &ReferenceJob, mut log: impl FnMut(&str)) -> Result<Reference, Error> {
-    job.solve.check().map_err(Error::Invalid)?;
+    job.solve.check()?;
     export::prepare_dir(&job.out)?;
     let scene = load_scene(&job.source, &job.load)?;
     let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
@@ -112,10 +112,10 @@ pub struct CompareJob {
     /// Time budget per method.
     pub budget: Duration,
     /// Seed, tolerance, stop fraction, hemi-cube resolution and gathering cap of the runs.
-    pub solve: SolveConfig,
+    pub solve: SolveSettings,
     /// A reference patch table; built (with `reference_solve`) when none is given.
     pub reference: Option<PathBuf>,
-    pub reference_solve: SolveConfig,
+    pub reference_solve: SolveSettings,
     pub intersector: IntersectorKind,
     /// Error levels (fractions) of the time-to-error table.
     pub levels: Vec<f64>,
@@ -199,11 +199,10 @@ fn validate(job: &CompareJob) -> Result<(), Error> {
         )));
     }
     let s = &job.solve;
-    s.check().map_err(Error::Invalid)?;
+    s.check()?;
     if job.reference.is_none() {
         job.reference_solve
             .check()
-            .map_err(Error::Invalid)
             .map_err(|e| Error::Invalid(format!("reference: {e}")))?;
     }
     Ok(())
@@ -265,15 +264,18 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
     let mut all: Vec<Vec<MethodRun>> = job.methods.iter().map(|_| Vec::new()).collect();
     for round in 0..job.repeat.max(1) {
         for (k, &method) in job.methods.iter().enumerate() {
-            let cfg = SolveConfig {
+            let cfg = SolveSettings {
                 method,
-                max_time: Some(job.budget),
-                reference: Some(b_ref.clone()),
+                max_time: Some(job.budget.as_secs_f64()),
                 switch_at: None,
                 ..job.solve.clone()
             };
-            let sol =
-                solve::run(&m, &scene.materials, isect.as_ref(), &cfg, |_| {}).map_err(fail)?;
+            let hooks = solve::RunHooks {
+                reference: Some(b_ref.clone()),
+                ..Default::default()
+            };
+            let sol = solve::run(&m, &scene.materials, isect.as_ref(), &cfg, &hooks, |_| {})
+                .map_err(fail)?;
             let last = sol.stats.trace.last();
             let run = MethodRun {
                 method,

@@ -20,7 +20,7 @@ use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
 use crate::solve::error::{self, ErrorMetrics};
-use crate::solve::{self, MethodKind, SolveConfig, SolveError, StopReason};
+use crate::solve::{self, MethodKind, SolveError, SolveSettings, StopReason};
 use std::time::Instant;
 
 /// How far the measured difference of the halves may be from what the bound predicts.
@@ -85,18 +85,17 @@ pub fn build<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
     isect: &I,
-    cfg: &SolveConfig,
+    cfg: &SolveSettings,
 ) -> Result<Reference, SolveError> {
     let t = Instant::now();
     let seeds = [cfg.seed, cfg.seed.wrapping_add(0x9E37_79B9_7F4A_7C15)];
     let half = |seed: u64| {
-        let c = SolveConfig {
+        let c = SolveSettings {
             seed,
             method: MethodKind::AdaptiveRays,
             tolerance: cfg.tolerance * std::f64::consts::SQRT_2,
             // Energy per ray ∝ tolerance²: twice the energy, half the rays.
             energy_per_ray: cfg.energy_per_ray.map(|c| 2.0 * c),
-            reference: None,
             ..cfg.clone()
         };
         solve::solve(mesh, materials, isect, &c, |_| {})

@@ -239,12 +239,13 @@ pub fn shoot_matrix(
 pub fn gather(
     mesh: &Mesh,
     materials: &[Material],
-    cfg: &super::SolveConfig,
+    cfg: &super::SolveSettings,
+    hooks: &super::RunHooks,
     mut on_trace: impl FnMut(&TracePoint),
 ) -> Solution {
     let (n_cube, seed, stop_fraction) = (cfg.hemicube_n, cfg.seed, cfg.stop_fraction);
-    let reference = cfg.reference.as_deref().map(Vec::as_slice);
-    let light_groups = cfg.light_groups.as_deref();
+    let reference = hooks.reference.as_deref().map(Vec::as_slice);
+    let light_groups = hooks.light_groups.as_deref();
     let start = Instant::now();
     let n = mesh.patches.len();
     let ff = FormFactors::by_hemicube(mesh, n_cube, seed);

@@ -13,148 +13,14 @@ pub mod error;
 pub mod gathering;
 pub mod lights;
 pub mod progressive;
+pub mod settings;
 mod state;
 
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
 
-use std::time::Duration;
-
-/// How form factors are sampled (`radiosity solve --method …`; the paper's Sec. 2 and 4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum MethodKind {
-    /// Shooting with the adaptive polar hemisphere ray sampler (Sec. 2).
-    AdaptiveRays,
-    /// Shooting with the uniform N×N hemi-cube of Cohen & Greenberg 1985: the non-adaptive
-    /// baseline.
-    Hemicube,
-    /// The uniform hemi-cube with each cell's sample point jittered (Table 1, third column).
-    HemicubeJittered,
-    /// Shooting with the paper's non-uniform hemi-cube, its resolution from the unshot energy.
-    AdaptiveHemicube,
-    /// The adaptive hemi-cube while shots carry much energy, then adaptive rays once a ray shot
-    /// is measured to be cheaper (Sec. 4: curves C then D). The default.
-    #[default]
-    AdaptiveHybrid,
-    /// The traditional algorithm: full form-factor matrix by the uniform hemi-cube, then
-    /// Gauss–Seidel.
-    Gathering,
-}
-
-impl MethodKind {
-    /// Whether the method casts rays (and so needs an intersector).
-    pub fn casts_rays(&self) -> bool {
-        matches!(self, MethodKind::AdaptiveRays | MethodKind::AdaptiveHybrid)
-    }
-
-    pub fn name(&self) -> &'static str {
-        match self {
-            MethodKind::AdaptiveRays => "adaptive-rays",
-            MethodKind::Hemicube => "hemicube",
-            MethodKind::HemicubeJittered => "hemicube-jittered",
-            MethodKind::AdaptiveHemicube => "adaptive-hemicube",
-            MethodKind::AdaptiveHybrid => "adaptive-hybrid",
-            MethodKind::Gathering => "gathering",
-        }
-    }
-}
-
-/// What the solver does, independent of the scene.
-#[derive(Clone, Debug)]
-pub struct SolveConfig {
-    /// Seed of every random choice; the result depends on it and nothing else (not the number
-    /// of threads).
-    pub seed: u64,
-    /// Requested relative sampling error of a typical patch's radiosity; sets the energy per
-    /// ray (see [`progressive::energy_per_ray`]).
-    pub tolerance: f64,
-    /// Overrides the energy per ray C (W, scalar flux) derived from `tolerance`.
-    pub energy_per_ray: Option<f64>,
-    /// Sec. 3: stop when max unshot radiosity < this fraction of the mean radiosity (0.0006).
-    pub stop_fraction: f64,
-    pub max_time: Option<Duration>,
-    pub max_rays: Option<u64>,
-    /// Place each ray uniformly inside its polar cell (default) rather than at its centre.
-    pub jitter: bool,
-    pub method: MethodKind,
-    /// Resolution N of the uniform hemi-cube (the `hemicube` methods and gathering).
-    pub hemicube_n: usize,
-    /// Gathering refuses scenes whose form-factor matrix needs more memory than this (MiB).
-    pub gather_cap_mib: u64,
-    /// `adaptive-hybrid`: switch to rays at this shot instead of when measured costs say so.
-    /// The measured switch depends on timings, so it can differ between runs; giving the shot
-    /// a summary recorded makes the run reproducible exactly.
-    pub switch_at: Option<u64>,
-    /// Radiosity per patch of a reference solution (`--reference`): every trace point then
-    /// records the error against it.
-    pub reference: Option<std::sync::Arc<Vec<[f64; 3]>>>,
-    /// Keep one channel per light group (`--per-light`): the solution then carries each
-    /// light's own radiosity, for relighting without solving again.
-    pub light_groups: Option<std::sync::Arc<lights::LightGroups>>,
-    /// Write a checkpoint at the first safe point every so often, and on interrupt
-    /// (`--checkpoint`), through this sink.
-    pub checkpoint: Option<checkpoint::Sink>,
-    /// Continue from this checkpoint (`--resume`).
-    pub resume: Option<std::sync::Arc<checkpoint::Snapshot>>,
-    /// Set (by a Ctrl-C handler) to stop at the next safe point.
-    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-}
-
-impl Default for SolveConfig {
-    fn default() -> Self {
-        SolveConfig {
-            seed: 1,
-            tolerance: 0.05,
-            energy_per_ray: None,
-            stop_fraction: 0.0006,
-            max_time: None,
-            max_rays: None,
-            jitter: true,
-            method: MethodKind::AdaptiveHybrid,
-            hemicube_n: 100,
-            gather_cap_mib: 4096,
-            switch_at: None,
-            reference: None,
-            light_groups: None,
-            checkpoint: None,
-            resume: None,
-            interrupt: None,
-        }
-    }
-}
-
-impl SolveConfig {
-    /// Checks the settings a user can get wrong (one line naming the flag), before any work.
-    pub fn check(&self) -> Result<(), String> {
-        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
-            return Err(format!(
-                "--tolerance must be in (0, 1), got {}",
-                self.tolerance
-            ));
-        }
-        if !(self.stop_fraction > 0.0 && self.stop_fraction.is_finite()) {
-            return Err(format!(
-                "--stop must be a positive fraction, got {}",
-                self.stop_fraction
-            ));
-        }
-        if !(2..=4096).contains(&self.hemicube_n) {
-            return Err(format!(
-                "--hemicube-n must be between 2 and 4096, got {}",
-                self.hemicube_n
-            ));
-        }
-        if self.switch_at.is_some() && self.method != MethodKind::AdaptiveHybrid {
-            return Err(format!(
-                "--switch-at applies to --method adaptive-hybrid only, not {}",
-                self.method.name()
-            ));
-        }
-        Ok(())
-    }
-}
+pub use settings::{MethodKind, RunHooks, SolveSettings};
 
 /// Why the solve stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -308,15 +174,22 @@ pub enum SolveError {
     NoIntersector(&'static str),
 }
 
-/// Solves by the method `cfg.method` names, casting rays through `isect`.
+/// Solves by the method `cfg.method` names, casting rays through `isect`, with no hooks.
 pub fn solve<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
     isect: &I,
-    cfg: &SolveConfig,
+    cfg: &SolveSettings,
     on_trace: impl FnMut(&TracePoint),
 ) -> Result<Solution, SolveError> {
-    run(mesh, materials, Some(isect), cfg, on_trace)
+    run(
+        mesh,
+        materials,
+        Some(isect),
+        cfg,
+        &RunHooks::default(),
+        on_trace,
+    )
 }
 
 /// Solves by the method `cfg.method` names. `isect` is needed only by methods that cast rays
@@ -325,7 +198,8 @@ pub fn run<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
     isect: Option<&I>,
-    cfg: &SolveConfig,
+    cfg: &SolveSettings,
+    hooks: &RunHooks,
     on_trace: impl FnMut(&TracePoint),
 ) -> Result<Solution, SolveError> {
     match cfg.method {
@@ -338,7 +212,7 @@ pub fn run<I: Intersector>(
             {
                 return Err(SolveError::NoEmitter);
             }
-            if let Some(r) = &cfg.reference {
+            if let Some(r) = &hooks.reference {
                 if r.len() != mesh.patches.len() {
                     return Err(SolveError::ReferenceMismatch {
                         reference: r.len(),
@@ -346,8 +220,8 @@ pub fn run<I: Intersector>(
                     });
                 }
             }
-            Ok(gathering::gather(mesh, materials, cfg, on_trace))
+            Ok(gathering::gather(mesh, materials, cfg, hooks, on_trace))
         }
-        _ => progressive::shoot(mesh, materials, isect, cfg, on_trace),
+        _ => progressive::shoot(mesh, materials, isect, cfg, hooks, on_trace),
     }
 }

@@ -20,8 +20,8 @@ use super::cube_shots::{self, CubeCost, CubeHits, CubeKind, CubeShooter, CubeSho
 use super::error::Estimator;
 use super::state::{rng_for, State};
 use super::{
-    scalar, MethodKind, Solution, SolveConfig, SolveError, SolveStats, StopReason, SwitchInfo,
-    TracePoint,
+    scalar, MethodKind, RunHooks, Solution, SolveError, SolveSettings, SolveStats, StopReason,
+    SwitchInfo, TracePoint,
 };
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::Mesh;
@@ -293,7 +293,8 @@ pub fn shoot<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
     isect: Option<&I>,
-    cfg: &SolveConfig,
+    cfg: &SolveSettings,
+    hooks: &RunHooks,
     mut on_trace: impl FnMut(&TracePoint),
 ) -> Result<Solution, SolveError> {
     let start = Instant::now();
@@ -309,10 +310,10 @@ pub fn shoot<I: Intersector>(
     if scalar(&st.energy.emitted) <= 0.0 {
         return Err(SolveError::NoEmitter);
     }
-    if let Some(g) = &cfg.light_groups {
+    if let Some(g) = &hooks.light_groups {
         st.start_channels(&g.of_patch, g.len());
     }
-    if let Some(r) = &cfg.reference {
+    if let Some(r) = &hooks.reference {
         if r.len() != n {
             return Err(SolveError::ReferenceMismatch {
                 reference: r.len(),
@@ -348,7 +349,7 @@ pub fn shoot<I: Intersector>(
         energy_per_ray: c_ray,
         rho_mean: rho_s.iter().zip(&area).map(|(r, a)| r * a).sum::<f64>() / mesh.total_area(),
     };
-    let reference = cfg.reference.as_deref().map(Vec::as_slice);
+    let reference = hooks.reference.as_deref().map(Vec::as_slice);
 
     let (lo, hi) = mesh.vertices.iter().fold(
         (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
@@ -385,7 +386,7 @@ pub fn shoot<I: Intersector>(
     };
     // Resuming: the books, the counters and the trace so far (see `checkpoint`).
     let mut time_offset = 0.0;
-    if let Some(snap) = &cfg.resume {
+    if let Some(snap) = &hooks.resume {
         let h = &snap.header;
         if (h.energy_per_ray - c_ray).abs() > 1e-12 * c_ray {
             return Err(SolveError::Checkpoint(format!(
@@ -423,11 +424,11 @@ pub fn shoot<I: Intersector>(
             if let Some(p) = pending.take() {
                 apply_rays(&mut st, &p.wave, &p.tasks, &p.hits);
             }
-            let interrupted = cfg
+            let interrupted = hooks
                 .interrupt
                 .as_ref()
                 .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
-            if let Some(sink) = &cfg.checkpoint {
+            if let Some(sink) = &hooks.checkpoint {
                 if interrupted || elapsed >= next_checkpoint {
                     let snap = st.snapshot(Header {
                         key: sink.key.clone(),
@@ -474,7 +475,7 @@ pub fn shoot<I: Intersector>(
             } else {
                 Some(StopReason::Exhausted)
             }
-        } else if cfg.max_time.is_some_and(|t| elapsed >= t.as_secs_f64()) {
+        } else if cfg.max_time.is_some_and(|t| elapsed >= t) {
             Some(StopReason::MaxTime)
         } else if cfg.max_rays.is_some_and(|r| samples >= r) {
             Some(StopReason::MaxRays)
@@ -627,7 +628,7 @@ pub fn shoot<I: Intersector>(
     stats.energy = st.energy;
     stats.stop_reason = Some(stop_reason);
     stats.seconds = time_offset + start.elapsed().as_secs_f64();
-    let channels = match &cfg.light_groups {
+    let channels = match &hooks.light_groups {
         Some(g) => st
             .channel_radiosity(mesh, materials, &g.of_patch)
             .into_iter()

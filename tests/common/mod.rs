@@ -114,11 +114,21 @@ pub fn mesh_at(scene: &Scene, patch_size: Option<f32>) -> radiosity::mesh::Mesh 
 pub fn solve_mesh(
     scene: &Scene,
     m: &radiosity::mesh::Mesh,
-    cfg: &radiosity::solve::SolveConfig,
+    cfg: &radiosity::solve::SolveSettings,
+) -> radiosity::solve::Solution {
+    solve_mesh_with(scene, m, cfg, &Default::default())
+}
+
+/// [`solve_mesh`] with hooks (per-light channels, a reference, checkpoints).
+pub fn solve_mesh_with(
+    scene: &Scene,
+    m: &radiosity::mesh::Mesh,
+    cfg: &radiosity::solve::SolveSettings,
+    hooks: &radiosity::solve::RunHooks,
 ) -> radiosity::solve::Solution {
     let isect = cfg
         .method
         .casts_rays()
         .then(|| radiosity::intersect::embree::EmbreeScene::build(m, |_| true).unwrap());
-    radiosity::solve::run(m, &scene.materials, isect.as_ref(), cfg, |_| {}).unwrap()
+    radiosity::solve::run(m, &scene.materials, isect.as_ref(), cfg, hooks, |_| {}).unwrap()
 }

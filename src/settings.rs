@@ -1,0 +1,20 @@
+//! Settings a user gives, and the one error a bad one makes.
+//!
+//! Each concern has one plain, serialisable settings type beside the code it steers:
+//! [`crate::scene::LoadOptions`] (how a model is read), [`crate::mesh::MeshOptions`] (how it is
+//! cut into patches), [`crate::solve::SolveSettings`] (how it is solved),
+//! [`crate::render::ViewSettings`] (camera and picture). Each checks itself, once, in the
+//! library, with a message that names the flag; the commands call those checks and add none of
+//! their own, so every command refuses what `solve` refuses, in the same words.
+
+/// A setting a user got wrong: one line naming the flag and the value.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct Invalid(pub String);
+
+impl Invalid {
+    /// `Err(Invalid(message))`.
+    pub fn err<T>(message: impl Into<String>) -> Result<T, Invalid> {
+        Err(Invalid(message.into()))
+    }
+}

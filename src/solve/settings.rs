@@ -1,0 +1,254 @@
+//! What a solve is asked to do ([`SolveSettings`]: plain, serialisable, checked once) and what
+//! the run around it plugs in ([`RunHooks`]: a reference to measure against, per-light
+//! channels, checkpoints, an interrupt flag).
+//!
+//! The settings are the whole of what shapes a result: the same scene, mesh and settings give
+//! the same patch table on any run and any thread count. So everything that records "how was
+//! this solved" (the summary, the saved solution, a comparison's rows, the key a checkpoint must
+//! match) is derived from this one type by serialising it, never listed field by field; a new
+//! setting added here reaches all of them.
+//!
+//! Defaults are constants, used by `Default` and by the command line's `default_value_t` alike.
+
+use super::{checkpoint, lights};
+use crate::settings::Invalid;
+use serde::{Deserialize, Serialize};
+
+/// Default seed of every random choice.
+pub const DEFAULT_SEED: u64 = 1;
+/// Default relative sampling error of a typical patch's radiosity (`--tolerance`).
+pub const DEFAULT_TOLERANCE: f64 = 0.05;
+/// Sec. 3: stop when the max unshot radiosity is below 0.06 % of the mean radiosity.
+pub const DEFAULT_STOP: f64 = 0.0006;
+/// Default resolution N of the uniform N×N hemi-cube (the paper's reference is 100×100).
+pub const DEFAULT_HEMICUBE_N: usize = 100;
+/// Gathering refuses form-factor matrices above this many MiB by default.
+pub const DEFAULT_GATHER_CAP_MIB: u64 = 4096;
+/// `radiosity reference`: tolerance and stop fraction (100× the rays of a default solve).
+pub const REFERENCE_TOLERANCE: f64 = 0.005;
+pub const REFERENCE_STOP: f64 = 1e-5;
+
+/// How form factors are sampled (`radiosity solve --method …`; the paper's Sec. 2 and 4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum MethodKind {
+    /// Shooting with the adaptive polar hemisphere ray sampler (Sec. 2).
+    AdaptiveRays,
+    /// Shooting with the uniform N×N hemi-cube of Cohen & Greenberg 1985: the non-adaptive
+    /// baseline.
+    Hemicube,
+    /// The uniform hemi-cube with each cell's sample point jittered (Table 1, third column).
+    HemicubeJittered,
+    /// Shooting with the paper's non-uniform hemi-cube, its resolution from the unshot energy.
+    AdaptiveHemicube,
+    /// The adaptive hemi-cube while shots carry much energy, then adaptive rays once a ray shot
+    /// is cheaper (Sec. 4: curves C then D). The default.
+    #[default]
+    AdaptiveHybrid,
+    /// The traditional algorithm: full form-factor matrix by the uniform hemi-cube, then
+    /// Gauss–Seidel.
+    Gathering,
+}
+
+impl MethodKind {
+    /// Every method, in the order `radiosity compare` runs them by default.
+    pub const ALL: [MethodKind; 6] = [
+        MethodKind::AdaptiveHybrid,
+        MethodKind::AdaptiveRays,
+        MethodKind::AdaptiveHemicube,
+        MethodKind::Hemicube,
+        MethodKind::HemicubeJittered,
+        MethodKind::Gathering,
+    ];
+
+    /// Whether the method casts rays (and so needs an intersector).
+    pub fn casts_rays(&self) -> bool {
+        matches!(self, MethodKind::AdaptiveRays | MethodKind::AdaptiveHybrid)
+    }
+
+    /// Whether the method uses the uniform N×N hemi-cube (and so `hemicube_n`).
+    pub fn uses_uniform_cube(&self) -> bool {
+        matches!(
+            self,
+            MethodKind::Hemicube | MethodKind::HemicubeJittered | MethodKind::Gathering
+        )
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            MethodKind::AdaptiveRays => "adaptive-rays",
+            MethodKind::Hemicube => "hemicube",
+            MethodKind::HemicubeJittered => "hemicube-jittered",
+            MethodKind::AdaptiveHemicube => "adaptive-hemicube",
+            MethodKind::AdaptiveHybrid => "adaptive-hybrid",
+            MethodKind::Gathering => "gathering",
+        }
+    }
+}
+
+/// What the solver does, independent of the scene: the settings of `solve`, `compare`,
+/// `reference`, `sweep` and the benchmarks alike.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SolveSettings {
+    pub method: MethodKind,
+    /// Seed of every random choice; the result depends on it and nothing else (not the number
+    /// of threads, not the clock).
+    pub seed: u64,
+    /// Requested relative sampling error of a typical patch's radiosity; sets the energy per
+    /// ray (see [`super::progressive::energy_per_ray`]).
+    pub tolerance: f64,
+    /// Overrides the energy per ray C (W, scalar flux) derived from `tolerance`.
+    pub energy_per_ray: Option<f64>,
+    /// Sec. 3: stop when max unshot radiosity < this fraction of the mean radiosity (0.0006).
+    pub stop_fraction: f64,
+    /// Stop after this many seconds (the one setting that makes a result depend on the clock).
+    pub max_time: Option<f64>,
+    /// Stop after about this many form-factor samples (rays plus hemi-cube cells).
+    pub max_rays: Option<u64>,
+    /// Place each ray uniformly inside its polar cell (default) rather than at its centre.
+    pub jitter: bool,
+    /// Resolution N of the uniform hemi-cube (the `hemicube` methods and gathering).
+    pub hemicube_n: usize,
+    /// Gathering refuses scenes whose form-factor matrix needs more memory than this (MiB).
+    pub gather_cap_mib: u64,
+    /// `adaptive-hybrid`: switch to rays at this shot instead of when the cost model says so.
+    pub switch_at: Option<u64>,
+}
+
+impl Default for SolveSettings {
+    fn default() -> Self {
+        SolveSettings {
+            method: MethodKind::default(),
+            seed: DEFAULT_SEED,
+            tolerance: DEFAULT_TOLERANCE,
+            energy_per_ray: None,
+            stop_fraction: DEFAULT_STOP,
+            max_time: None,
+            max_rays: None,
+            jitter: true,
+            hemicube_n: DEFAULT_HEMICUBE_N,
+            gather_cap_mib: DEFAULT_GATHER_CAP_MIB,
+            switch_at: None,
+        }
+    }
+}
+
+impl SolveSettings {
+    /// The settings of `radiosity reference` (adaptive rays, 100× the rays of a default solve).
+    pub fn reference(seed: u64) -> SolveSettings {
+        SolveSettings {
+            method: MethodKind::AdaptiveRays,
+            seed,
+            tolerance: REFERENCE_TOLERANCE,
+            stop_fraction: REFERENCE_STOP,
+            ..SolveSettings::default()
+        }
+    }
+
+    /// Checks the settings a user can get wrong (one line naming the flag), before any work.
+    /// Every command that solves calls this, so each refuses what `solve` refuses, in the same
+    /// words.
+    pub fn check(&self) -> Result<(), Invalid> {
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
+            return Invalid::err(format!(
+                "--tolerance must be in (0, 1), got {}",
+                self.tolerance
+            ));
+        }
+        if !(self.stop_fraction > 0.0 && self.stop_fraction.is_finite()) {
+            return Invalid::err(format!(
+                "--stop must be a positive fraction, got {}",
+                self.stop_fraction
+            ));
+        }
+        if let Some(c) = self.energy_per_ray {
+            if !(c > 0.0 && c.is_finite()) {
+                return Invalid::err(format!(
+                    "--energy-per-ray must be a positive number of watts, got {c}"
+                ));
+            }
+        }
+        if let Some(t) = self.max_time {
+            if !(t > 0.0 && t.is_finite()) {
+                return Invalid::err(format!(
+                    "--max-time must be a positive number of seconds, got {t}"
+                ));
+            }
+        }
+        if self.max_rays == Some(0) {
+            return Invalid::err("--max-rays must be at least 1 (leave it out for no limit)");
+        }
+        if !(2..=4096).contains(&self.hemicube_n) {
+            return Invalid::err(format!(
+                "--hemicube-n must be between 2 and 4096, got {}",
+                self.hemicube_n
+            ));
+        }
+        if self.switch_at.is_some() && self.method != MethodKind::AdaptiveHybrid {
+            return Invalid::err(format!(
+                "--switch-at applies to --method adaptive-hybrid only, not {}",
+                self.method.name()
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What a run plugs into the solver besides its settings: none of it changes the result
+/// (a checkpoint or an interrupt changes only where the run stops or resumes).
+#[derive(Clone, Default)]
+pub struct RunHooks {
+    /// Radiosity per patch of a reference solution (`--reference`): every trace point then
+    /// records the error against it.
+    pub reference: Option<std::sync::Arc<Vec<[f64; 3]>>>,
+    /// Keep one channel per light group (`--per-light`): the solution then carries each
+    /// light's own radiosity, for relighting without solving again.
+    pub light_groups: Option<std::sync::Arc<lights::LightGroups>>,
+    /// Write a checkpoint at the first safe point every so often, and on interrupt
+    /// (`--checkpoint`), through this sink.
+    pub checkpoint: Option<checkpoint::Sink>,
+    /// Continue from this checkpoint (`--resume`).
+    pub resume: Option<std::sync::Arc<checkpoint::Snapshot>>,
+    /// Set (by a Ctrl-C handler) to stop at the next safe point.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+}
+
+impl std::fmt::Debug for RunHooks {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunHooks")
+            .field("reference", &self.reference.as_ref().map(|r| r.len()))
+            .field("light_groups", &self.light_groups.as_ref().map(|g| g.len()))
+            .field("checkpoint", &self.checkpoint.is_some())
+            .field("resume", &self.resume.is_some())
+            .field("interrupt", &self.interrupt.is_some())
+            .finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_round_trip_through_json() {
+        let s = SolveSettings {
+            method: MethodKind::Hemicube,
+            energy_per_ray: Some(0.1 + 0.2),
+            max_time: Some(1.5),
+            ..SolveSettings::default()
+        };
+        let text = serde_json::to_string(&s).unwrap();
+        assert_eq!(serde_json::from_str::<SolveSettings>(&text).unwrap(), s);
+    }
+
+    #[test]
+    fn defaults_pass_the_check_and_bad_values_name_their_flag() {
+        assert!(SolveSettings::default().check().is_ok());
+        let bad = SolveSettings {
+            tolerance: 5.0,
+            ..SolveSettings::default()
+        };
+        assert!(bad.check().unwrap_err().0.starts_with("--tolerance"));
+    }
+}
