@@ -4,6 +4,7 @@
 use crate::export::solution::SolutionError;
 use crate::export::WriteError;
 use crate::intersect::embree::EmbreeError;
+use crate::intersect::select::SelectError;
 use crate::scene::SceneError;
 use crate::solve::SolveError;
 
@@ -21,6 +22,9 @@ pub enum Error {
     Write(#[from] WriteError),
     #[error(transparent)]
     Embree(#[from] EmbreeError),
+    /// The intersector asked for does not suit the scene, or could not be built.
+    #[error(transparent)]
+    Select(SelectError),
     /// A saved solution that cannot be used (`render`, `export`).
     #[error(transparent)]
     Solution(#[from] SolutionError),
@@ -48,5 +52,14 @@ impl Error {
 impl From<crate::settings::Invalid> for Error {
     fn from(e: crate::settings::Invalid) -> Error {
         Error::Invalid(e.0)
+    }
+}
+
+impl From<SelectError> for Error {
+    fn from(e: SelectError) -> Error {
+        match e {
+            SelectError::Embree(e) => Error::Embree(e),
+            e => Error::Select(e),
+        }
     }
 }

@@ -4,31 +4,42 @@
 //! *Two Adaptive Techniques Let Progressive Refinement Outperform the Traditional Radiosity
 //! Algorithm* (UNC TR89-020, 1989).
 //!
-//! The pipeline (DESIGN.md §1): [`scene`] loads OBJ + MTL, [`mesh`] cuts polygons into patches,
-//! [`intersect`] builds the ray intersectors, [`solve`] shoots energy with the paper's adaptive
-//! polar hemisphere sampler ([`sample`]), and [`render`], [`export`] and [`report`] hand the
-//! solution on. The `radiosity` binary is a thin layer over this library.
+//! The core, in pipeline order (docs/design.md §1); each layer uses only those above it:
+//!
+//! - [`scene`] loads OBJ + MTL (materials ρ, emission, lights);
+//! - [`mesh`] cuts polygons into patches; [`model`] is a loaded scene with its mesh and the
+//!   intersector a command asks for, built once;
+//! - [`intersect`] casts rays (Embree 4, the paper's three-way plane merge, their hybrid);
+//! - [`sample`] holds the paper's samplers: the adaptive polar hemisphere and the uniform and
+//!   non-uniform hemi-cubes (Sec. 2);
+//! - [`solve`] shoots (or gathers) energy: the driver, ray shots, hemi-cube shots, the hybrid's
+//!   switch (Sec. 4), the stopping rule (Sec. 3) and the energy books.
+//!
+//! Around it: [`settings`] (the settings types and their one error), [`pipeline`] (what
+//! `radiosity solve` and `info` do), [`saved`] (commands on a saved solution: render, export,
+//! relight), [`compare`] (reference and methods side by side), [`bench`] (benchmarks,
+//! cross-checks and the scene-size sweep), [`render`] (rasteriser, false colour, glyphs),
+//! [`export`] (file formats), [`report`] (summaries, traces, plots), [`generate`] (generated
+//! buildings). The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
+pub mod bench;
 pub mod compare;
 pub mod error;
 pub mod export;
-pub mod false_colour;
 pub mod generate;
-pub mod glyphs;
 pub mod intersect;
-pub mod intersect_jobs;
 pub mod mesh;
-pub mod outputs;
+pub mod model;
 pub mod pipeline;
 pub mod progress;
 pub mod render;
 pub mod report;
 pub mod sample;
+pub mod saved;
 pub mod scene;
 pub mod settings;
 pub mod shot_bench;
 pub mod solve;
-pub mod sweep;
 
 pub use error::Error;

@@ -65,13 +65,26 @@ use crate::scene::Scene;
 use std::collections::HashMap;
 
 /// How to cut the scene into patches.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct MeshOptions {
     /// Longest patch edge (metres); `None` takes the scene's own hint
     /// ([`Scene::patch_size_hint`]) or derives one from the scene ([`default_patch_size`]).
     pub patch_size: Option<f32>,
     /// Give every polygon a back patch of its own (thin surfaces seen from both sides).
     pub two_sided: bool,
+}
+
+impl MeshOptions {
+    /// Checks what a user can get wrong (one line naming the flag).
+    pub fn check(&self) -> Result<(), crate::settings::Invalid> {
+        match self.patch_size {
+            Some(ps) if !(ps > 0.0 && ps.is_finite()) => crate::settings::Invalid::err(format!(
+                "--patch-size must be a positive length in metres, got {ps}"
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Patch count the derived default patch size aims at: enough to show soft shadows in a room,

@@ -13,10 +13,11 @@
 
 use crate::intersect::embree::EmbreeScene;
 use crate::mesh::MeshOptions;
-use crate::pipeline::{load_scene, SceneSource};
+use crate::model::Model;
 use crate::sample::hemicube::{Hemicube, HemicubeBuffer};
 use crate::sample::Frame;
 use crate::scene::LoadOptions;
+use crate::scene::SceneSource;
 use crate::solve::{self, progressive, MethodKind, SolveSettings, SwitchInfo};
 use crate::Error;
 use serde::Serialize;
@@ -115,8 +116,8 @@ pub fn bench_shots(
     ns: &[usize],
     shooters: usize,
 ) -> Result<ShotBench, Error> {
-    let scene = load_scene(source, load)?;
-    let m = crate::pipeline::build_mesh(&scene, mesh_opts)?;
+    cfg.check()?;
+    let Model { scene, mesh: m } = Model::load(source, load, mesh_opts)?;
     let n = m.patches.len();
     let count = shooters.clamp(1, n.max(1));
     let from: Vec<usize> = (0..count).map(|k| k * n / count).collect();

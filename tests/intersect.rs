@@ -6,8 +6,8 @@ mod common;
 
 use common::*;
 use glam::{vec3, Vec3};
+use radiosity::bench::crosscheck::{self, Class, Judge, RayGen, RaySource, TestRay};
 use radiosity::intersect::brute::BruteForce;
-use radiosity::intersect::crosscheck::{self, Class, Judge, RayGen, RaySource, TestRay};
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::intersect::hybrid::Hybrid;
 use radiosity::intersect::plane_merge::PlaneMerge;
@@ -786,9 +786,11 @@ fn selection_builds_only_what_the_scene_needs() {
     let skew = mesh_of(&s, 0.5);
     let h = AnyIntersector::build(&skew, IntersectorKind::Hybrid).unwrap();
     assert_eq!((h.has_embree(), h.has_planes()), (true, false));
-    let err = AnyIntersector::build(&skew, IntersectorKind::Merge)
-        .err()
-        .expect("merge on a skew scene");
+    let err = radiosity::Error::from(
+        AnyIntersector::build(&skew, IntersectorKind::Merge)
+            .err()
+            .expect("merge on a skew scene"),
+    );
     assert_eq!(err.exit_code(), 2);
     assert!(err.to_string().contains("skew"), "{err}");
 }

@@ -6,7 +6,7 @@ mod common;
 
 use common::{assert_user_error, run};
 use radiosity::export::solution::{SavedSolution, FORMAT_VERSION};
-use radiosity::false_colour::{BACKGROUND, LEGEND_WIDTH};
+use radiosity::render::false_colour::{BACKGROUND, LEGEND_WIDTH};
 use std::path::{Path, PathBuf};
 
 fn ok(args: &[&str]) -> String {
@@ -337,8 +337,8 @@ fn false_colour_png_has_its_legend() {
         .collect();
     let has = |c: [u8; 3]| legend.contains(&c);
     assert!(has(BACKGROUND));
-    assert!(has(radiosity::false_colour::colour_at(0.0)));
-    assert!(has(radiosity::false_colour::colour_at(1.0)));
+    assert!(has(radiosity::render::false_colour::colour_at(0.0)));
+    assert!(has(radiosity::render::false_colour::colour_at(1.0)));
     assert!(has([230, 230, 230]));
     // The picture itself is in colour, not grey.
     assert!(img

@@ -7,23 +7,24 @@
 //! - [`report`]: `compare.csv` and `compare.md`; [`plot`]: the PNG plots.
 
 pub mod analysis;
-pub mod plot;
 pub mod reference;
 pub mod report;
 
+use crate::export::patches::read_reference;
 use crate::export::{self, patches, write_atomic};
-use crate::intersect::select::{self, IntersectorKind};
+use crate::intersect::select::IntersectorKind;
 use crate::intersect::Intersector;
 use crate::mesh::MeshOptions;
-use crate::pipeline::{load_reference, load_scene, SceneSource};
+use crate::model::Model;
 use crate::scene::LoadOptions;
+use crate::scene::SceneSource;
 use crate::solve::error::ErrorMetrics;
 use crate::solve::{self, MethodKind, SolveSettings, StopReason, SwitchInfo, TracePoint};
 use crate::Error;
 use reference::Reference;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 /// Everything `radiosity reference` does.
 #[derive(Clone, Debug)]
@@ -55,23 +56,23 @@ struct ReferenceSummary<'a> {
 pub fn run_reference(job: &ReferenceJob, mut log: impl FnMut(&str)) -> Result<Reference, Error> {
     job.solve.check()?;
     export::prepare_dir(&job.out)?;
-    let scene = load_scene(&job.source, &job.load)?;
-    let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
+    let model = Model::load(&job.source, &job.load, &job.mesh)?;
+    let (scene, m) = (&model.scene, &model.mesh);
     log(&format!(
         "{}: {} patches at {} m",
         scene.name,
         m.patches.len(),
         m.patch_size
     ));
-    let (isect, _) = select::select(&m, job.intersector)?;
-    let r = reference::build(&m, &scene.materials, &isect, &job.solve).map_err(|source| {
+    let (isect, _) = model.intersector(job.intersector)?;
+    let r = reference::build(m, &scene.materials, &isect, &job.solve).map_err(|source| {
         Error::Solve {
             scene: scene.name.clone(),
             source,
         }
     })?;
     write_atomic(&job.out.join("patches.csv"), |w| {
-        patches::write(w, &m, &scene.materials, &r.b)
+        patches::write(w, m, &scene.materials, &r.b)
     })?;
     let summary = ReferenceSummary {
         version: env!("CARGO_PKG_VERSION"),
@@ -109,8 +110,8 @@ pub struct CompareJob {
     pub mesh: MeshOptions,
     /// The methods, in order; speedups are of the first over each other.
     pub methods: Vec<MethodKind>,
-    /// Time budget per method.
-    pub budget: Duration,
+    /// Time budget per method (seconds).
+    pub budget: f64,
     /// Seed, tolerance, stop fraction, hemi-cube resolution and gathering cap of the runs.
     pub solve: SolveSettings,
     /// A reference patch table; built (with `reference_solve`) when none is given.
@@ -166,6 +167,11 @@ pub struct Comparison {
     pub reference_source: String,
     pub reference: Option<Reference>,
     pub levels: Vec<f64>,
+    /// The runs' settings (each run with its own method and `max_time` = the budget),
+    /// derived, not listed by hand.
+    pub settings: SolveSettings,
+    /// The settings of the reference built here (none when one was given).
+    pub reference_settings: Option<SolveSettings>,
     pub runs: Vec<MethodRun>,
 }
 
@@ -187,8 +193,8 @@ fn validate(job: &CompareJob) -> Result<(), Error> {
             )));
         }
     }
-    let b = job.budget.as_secs_f64();
-    if !(b > 0.0 && b.is_finite()) {
+    let b = job.budget;
+    if !(b > 0.0 && b.is_finite() && b < 1e7) {
         return Err(Error::Invalid(format!(
             "--budget must be a positive number of seconds, got {b}"
         )));
@@ -213,8 +219,8 @@ fn validate(job: &CompareJob) -> Result<(), Error> {
 pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Comparison, Error> {
     validate(job)?;
     export::prepare_dir(&job.out)?;
-    let scene = load_scene(&job.source, &job.load)?;
-    let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
+    let model = Model::load(&job.source, &job.load, &job.mesh)?;
+    let (scene, m) = (&model.scene, &model.mesh);
     log(&format!(
         "{}: {} patches at {} m",
         scene.name,
@@ -228,20 +234,20 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
     // One intersector for every method that casts rays, and for the reference.
     let needs_rays = job.reference.is_none() || job.methods.iter().any(|m| m.casts_rays());
     let isect = if needs_rays {
-        Some(select::select(&m, job.intersector)?.0)
+        Some(model.intersector(job.intersector)?.0)
     } else {
         None
     };
     let (b_ref, reference, reference_source) = match (&job.reference, &isect) {
-        (Some(path), _) => (load_reference(path, &m)?, None, path.display().to_string()),
+        (Some(path), _) => (read_reference(path, m)?, None, path.display().to_string()),
         (None, Some(isect)) => {
             let t = Instant::now();
             log(&format!(
                 "building the reference (adaptive rays, tolerance {}, stop {}) …",
                 job.reference_solve.tolerance, job.reference_solve.stop_fraction
             ));
-            let r = reference::build(&m, &scene.materials, isect, &job.reference_solve)
-                .map_err(fail)?;
+            let r =
+                reference::build(m, &scene.materials, isect, &job.reference_solve).map_err(fail)?;
             log(&format!(
                 "reference in {:.1} s: {}",
                 t.elapsed().as_secs_f64(),
@@ -250,7 +256,7 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
             let dir = job.out.join("reference");
             export::prepare_dir(&dir)?;
             write_atomic(&dir.join("patches.csv"), |w| {
-                patches::write(w, &m, &scene.materials, &r.b)
+                patches::write(w, m, &scene.materials, &r.b)
             })?;
             let b = r.b.clone();
             (b, Some(r), "built here (reference/patches.csv)".to_string())
@@ -266,7 +272,7 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
         for (k, &method) in job.methods.iter().enumerate() {
             let cfg = SolveSettings {
                 method,
-                max_time: Some(job.budget.as_secs_f64()),
+                max_time: Some(job.budget),
                 switch_at: None,
                 ..job.solve.clone()
             };
@@ -274,7 +280,7 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
                 reference: Some(b_ref.clone()),
                 ..Default::default()
             };
-            let sol = solve::run(&m, &scene.materials, isect.as_ref(), &cfg, &hooks, |_| {})
+            let sol = solve::run(m, &scene.materials, isect.as_ref(), &cfg, &hooks, |_| {})
                 .map_err(fail)?;
             let last = sol.stats.trace.last();
             let run = MethodRun {
@@ -317,7 +323,9 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
         patch_size: m.patch_size,
         threads: rayon::current_num_threads(),
         intersector: isect.as_ref().map_or("none (no rays cast)", |i| i.name()),
-        budget_s: job.budget.as_secs_f64(),
+        budget_s: job.budget,
+        settings: job.solve.clone(),
+        reference_settings: job.reference.is_none().then(|| job.reference_solve.clone()),
         tolerance: job.solve.tolerance,
         stop_fraction: job.solve.stop_fraction,
         hemicube_n: job.solve.hemicube_n,
@@ -339,7 +347,7 @@ pub fn write_outputs(cmp: &Comparison, dir: &Path) -> Result<(), Error> {
         serde_json::to_writer_pretty(&mut *w, cmp).map_err(std::io::Error::other)?;
         writeln!(w)
     })?;
-    for (name, png) in plot::all(cmp)? {
+    for (name, png) in report::plots(cmp)? {
         write_atomic(&dir.join(name), |w| w.write_all(&png))?;
     }
     Ok(())

@@ -4,8 +4,9 @@
 
 use super::analysis::{self, time_to_error};
 use super::{Comparison, MethodRun};
-use crate::export::trace;
+use crate::report::{plot, trace};
 use crate::solve::MethodKind;
+use crate::Error;
 use std::fmt::Write as _;
 use std::io::{self, Write};
 
@@ -211,4 +212,73 @@ pub fn markdown(cmp: &Comparison) -> String {
         analysis::energy_series(&r.trace)
     });
     s
+}
+
+fn shooters(cmp: &Comparison) -> impl Iterator<Item = &MethodRun> {
+    cmp.runs
+        .iter()
+        .filter(|r| r.method != MethodKind::Gathering)
+}
+
+/// The three plots of a comparison (error against time, Fig. 2's decay, Fig. 5's cost per
+/// shot), as (file name, PNG bytes).
+pub fn plots(cmp: &Comparison) -> Result<Vec<(&'static str, Vec<u8>)>, Error> {
+    let errors: Vec<plot::Curve> = cmp
+        .runs
+        .iter()
+        .map(|r| plot::Curve {
+            label: r.method.name().into(),
+            points: analysis::weighted_percent_series(&r.trace)
+                .into_iter()
+                .map(|(t, e)| (t, 100.0 * e))
+                .collect(),
+        })
+        .collect();
+    let decay: Vec<plot::Curve> = shooters(cmp)
+        .map(|r| plot::Curve {
+            label: match decay_of(r) {
+                Some(e) => format!("{} (E = {e:.4})", r.method.name()),
+                None => r.method.name().into(),
+            },
+            points: analysis::decay_curve(&r.trace),
+        })
+        .collect();
+    let cost: Vec<plot::Curve> = shooters(cmp)
+        .map(|r| plot::Curve {
+            label: r.method.name().into(),
+            points: analysis::cost_per_shot(&r.trace),
+        })
+        .collect();
+    Ok(vec![
+        (
+            "error_vs_time.png",
+            plot::draw(
+                &format!("{}: error against time", cmp.scene),
+                "seconds",
+                "average weighted percent error (%)",
+                &errors,
+                true,
+            )?,
+        ),
+        (
+            "decay.png",
+            plot::draw(
+                &format!("{}: max unshot radiosity (Fig. 2)", cmp.scene),
+                "percent of shots",
+                "max unshot / its start",
+                &decay,
+                false,
+            )?,
+        ),
+        (
+            "cost_per_shot.png",
+            plot::draw(
+                &format!("{}: cost per shot (Fig. 5)", cmp.scene),
+                "percent of shots",
+                "seconds per shot",
+                &cost,
+                false,
+            )?,
+        ),
+    ])
 }

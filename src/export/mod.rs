@@ -6,7 +6,6 @@ pub mod image;
 pub mod patches;
 pub mod ply;
 pub mod solution;
-pub mod trace;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};

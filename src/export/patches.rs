@@ -101,3 +101,42 @@ pub fn read(r: impl BufRead) -> io::Result<Vec<Row>> {
     }
     Ok(rows)
 }
+
+/// Reads a reference patch table and checks it belongs to this mesh (same patch count, and
+/// every patch's centre where this mesh has it). Returns its radiosity per patch.
+pub fn read_reference(
+    path: &std::path::Path,
+    m: &crate::mesh::Mesh,
+) -> Result<Vec<[f64; 3]>, crate::settings::Invalid> {
+    let bad =
+        |what: String| crate::settings::Invalid(format!("--reference {}: {what}", path.display()));
+    let file = std::fs::File::open(path).map_err(|e| bad(format!("cannot read it ({e})")))?;
+    let rows = read(std::io::BufReader::new(file)).map_err(|e| bad(e.to_string()))?;
+    if rows.len() != m.patches.len() {
+        return Err(bad(format!(
+            "it has {} patches but this mesh has {}: solve the reference with the same scene and --patch-size",
+            rows.len(),
+            m.patches.len()
+        )));
+    }
+    let (lo, hi) = m.vertices.iter().fold(
+        (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+        |(l, h), v| (l.min(*v), h.max(*v)),
+    );
+    let tol = 1e-4 * (hi - lo).max_element().max(f32::MIN_POSITIVE) as f64 + 1e-6;
+    for (k, (row, p)) in rows.iter().zip(&m.patches).enumerate() {
+        let c = [row.values[0], row.values[1], row.values[2]];
+        let far = (0..3).any(|a| (c[a] - p.centre[a] as f64).abs() > tol);
+        if row.id != k || far {
+            return Err(bad(format!(
+                "patch {k} is not where this mesh has it: the reference comes from another scene or patch size"
+            )));
+        }
+        if row.b().iter().any(|x| !x.is_finite() || *x < 0.0) {
+            return Err(bad(format!(
+                "patch {k} has a radiosity that is not a finite non-negative number"
+            )));
+        }
+    }
+    Ok(rows.iter().map(|r| r.b()).collect())
+}

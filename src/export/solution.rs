@@ -80,6 +80,10 @@ pub struct SolutionMeta {
     pub shots: u64,
     pub rays: u64,
     pub materials: Vec<SavedMaterial>,
+    /// Every setting that shaped the result (`pipeline::RunSettings` as JSON); null in files
+    /// written before it was recorded.
+    #[serde(default)]
+    pub settings: serde_json::Value,
 }
 
 /// One light's share of the radiosity (for relighting): B per patch with only that light on.
@@ -186,6 +190,28 @@ pub fn scene_hash(scene: &Scene, patch_size: f32, two_sided: bool) -> u64 {
 }
 
 impl SavedSolution {
+    /// Irradiance per patch (W/m²), `None` where the material reflects nothing.
+    pub fn irradiance(&self) -> Vec<Option<f64>> {
+        let sol = self;
+        const LUMA: [f64; 3] = [0.2126, 0.7152, 0.0722];
+        (0..sol.mesh.patches.len())
+            .map(|i| {
+                let mat = &sol.meta.materials[sol.mesh.patches[i].material as usize];
+                let e = sol.emission(i);
+                let (mut sum, mut w) = (0.0, 0.0);
+                for c in 0..3 {
+                    if mat.rho[c] > 0.0 {
+                        sum += LUMA[c] * (sol.b[i][c] - e[c]) / mat.rho[c];
+                        w += LUMA[c];
+                    }
+                }
+                (w > 0.0)
+                    .then(|| (sum / w).max(0.0))
+                    .filter(|h| h.is_finite())
+            })
+            .collect()
+    }
+
     /// Emitted radiosity E = π·Ke (W/m²) of patch `i`'s material.
     pub fn emission(&self, i: usize) -> [f64; 3] {
         let m = &self.meta.materials[self.mesh.patches[i].material as usize];
@@ -614,6 +640,7 @@ mod tests {
                     rho: [0.5; 3],
                     ke: [1.0; 3],
                 }],
+                settings: serde_json::Value::Null,
             },
             mesh,
             b: vec![[1.0, 2.0, 3.0]],

@@ -191,6 +191,33 @@ pub fn write_building(
     build(Some(obj), Some(mtl), mtl_name, opts)
 }
 
+/// Writes the building to the file `out` and its MTL beside it (same stem, `.mtl`), each
+/// atomically; refuses a building of no floor or no room.
+pub fn write_building_files(
+    out: &std::path::Path,
+    opts: &BuildingOptions,
+) -> Result<BuildingStats, crate::Error> {
+    use crate::export::write_atomic;
+    if opts.floors == 0 || opts.rooms_per_floor == 0 {
+        return Err(crate::Error::Invalid(
+            "--floors and --rooms must be at least 1".into(),
+        ));
+    }
+    let mtl_path = out.with_extension("mtl");
+    let mtl_name = mtl_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "building.mtl".into());
+    let mut mtl_text = Vec::new();
+    let mut stats = None;
+    write_atomic(out, |w| {
+        stats = Some(write_building(w, &mut mtl_text, &mtl_name, opts)?);
+        Ok(())
+    })?;
+    write_atomic(&mtl_path, |w| w.write_all(&mtl_text))?;
+    stats.ok_or_else(|| crate::Error::Invalid("the generator wrote nothing".into()))
+}
+
 // ---- dimensions, millimetres ------------------------------------------------------------
 
 const WALL: i64 = 200;

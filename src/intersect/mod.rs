@@ -7,9 +7,7 @@
 //! over axis-aligned planes (Sec. 2) and [`hybrid::Hybrid`] adds Embree for the skew patches.
 //! [`select::AnyIntersector`] is the enum a solve is built with (`--intersector`).
 
-pub mod bench;
 pub mod brute;
-pub mod crosscheck;
 pub mod embree;
 pub mod hybrid;
 pub mod plane_merge;

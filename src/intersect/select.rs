@@ -10,15 +10,25 @@
 //! [`auto_rule`] for the rule and the figures behind it.
 
 use super::brute::BruteForce;
+use super::embree::EmbreeError;
 use super::embree::EmbreeScene;
 use super::hybrid::Hybrid;
 use super::plane_merge::PlaneMerge;
 use super::{Hit, Intersector, Ray};
 use crate::mesh::{Mesh, PatchClass};
-use crate::Error;
+
+/// Why an intersector could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum SelectError {
+    /// `--intersector merge` on a scene with skew patches (the user's to fix).
+    #[error("--intersector merge needs a scene whose patches are all axis-aligned, but {skew} of {patches} are skew: use hybrid, embree or auto")]
+    NotAxial { skew: usize, patches: usize },
+    #[error(transparent)]
+    Embree(#[from] EmbreeError),
+}
 
 /// `--intersector`: which intersector to cast through.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum IntersectorKind {
     /// Chosen per scene by [`auto_rule`].
@@ -54,17 +64,16 @@ pub enum AnyIntersector {
 
 impl AnyIntersector {
     /// Builds the intersector of `kind` (not `Auto`) over `mesh`: only what it needs.
-    pub fn build(mesh: &Mesh, kind: IntersectorKind) -> Result<AnyIntersector, Error> {
+    pub fn build(mesh: &Mesh, kind: IntersectorKind) -> Result<AnyIntersector, SelectError> {
         Ok(match kind {
             IntersectorKind::Embree => AnyIntersector::Embree(EmbreeScene::build(mesh, |_| true)?),
             IntersectorKind::Merge => {
                 let skew = SceneShape::of(mesh).skew;
                 if skew > 0 {
-                    return Err(Error::Invalid(format!(
-                        "--intersector merge needs a scene whose patches are all axis-aligned, \
-                         but {skew} of {} are skew: use hybrid, embree or auto",
-                        mesh.patches.len()
-                    )));
+                    return Err(SelectError::NotAxial {
+                        skew,
+                        patches: mesh.patches.len(),
+                    });
                 }
                 AnyIntersector::Merge(PlaneMerge::build(mesh))
             }
@@ -173,7 +182,10 @@ pub fn auto_rule(shape: &SceneShape) -> (IntersectorKind, String) {
 }
 
 /// Resolves `kind` for `mesh` (applying [`auto_rule`] for `Auto`) and builds it.
-pub fn select(mesh: &Mesh, kind: IntersectorKind) -> Result<(AnyIntersector, Selection), Error> {
+pub fn select(
+    mesh: &Mesh,
+    kind: IntersectorKind,
+) -> Result<(AnyIntersector, Selection), SelectError> {
     let (chosen, reason) = match kind {
         IntersectorKind::Auto => auto_rule(&SceneShape::of(mesh)),
         k => (k, "forced by --intersector".to_string()),

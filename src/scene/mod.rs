@@ -14,6 +14,32 @@ pub use obj::{load_obj, load_obj_from_strs, LoadOptions, SceneError};
 
 use glam::Vec3;
 use std::f64::consts::PI;
+use std::path::PathBuf;
+
+/// Where a scene comes from.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SceneSource {
+    /// The built-in Cornell box.
+    Default,
+    File(PathBuf),
+}
+
+impl SceneSource {
+    /// `Some(path)` as a file, `None` as the built-in scene (the command line's optional
+    /// scene argument).
+    pub fn from_arg(path: Option<PathBuf>) -> SceneSource {
+        path.map_or(SceneSource::Default, SceneSource::File)
+    }
+
+    /// Loads the scene.
+    pub fn load(&self, opts: &LoadOptions) -> Result<Scene, SceneError> {
+        match self {
+            SceneSource::Default => default_scene(opts),
+            SceneSource::File(p) => load_obj(p, opts),
+        }
+    }
+}
 
 /// A diffuse material: reflectance ρ per RGB channel and emitted radiance `Ke`.
 #[derive(Clone, Debug, PartialEq)]

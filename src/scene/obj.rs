@@ -24,7 +24,8 @@ use std::collections::HashSet;
 use std::path::Path;
 
 /// Options for loading a scene.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct LoadOptions {
     /// `(material, [r, g, b])`: set the emitted radiance `Ke` (W/sr/m², the unit of MTL `Ke`)
     /// of every material of that name. A name that matches no material is an error.

@@ -9,7 +9,8 @@ use crate::mesh::Mesh;
 use crate::scene::Scene;
 
 /// How lights are grouped into channels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum GroupBy {
     /// One channel per emitting material (named after it).
     #[default]

@@ -1,12 +1,13 @@
 //! What `radiosity crosscheck` and `radiosity bench intersect` run: load or generate the
-//! scenes, mesh them, and hand them to [`crate::intersect::crosscheck`] and
-//! [`crate::intersect::bench`]. The binary only fills the jobs and prints.
+//! scenes, mesh them, and hand them to [`crate::bench::crosscheck`] and
+//! [`crate::bench::intersect_table`]. The binary only fills the jobs and prints.
 
+use super::crosscheck::{self, CrossReport, RaySource};
+use super::intersect_table::{self as bench, BenchRow};
 use crate::generate::{self, BuildingOptions};
-use crate::intersect::bench::{self, BenchRow};
-use crate::intersect::crosscheck::{self, CrossReport, RaySource};
 use crate::mesh::MeshOptions;
-use crate::pipeline::{load_scene, SceneSource};
+use crate::model::Model;
+use crate::scene::SceneSource;
 use crate::scene::{self, LoadOptions, Scene};
 use crate::Error;
 
@@ -40,18 +41,9 @@ impl std::fmt::Display for CrossCheck {
     }
 }
 
-fn check_patch_size(m: &MeshOptions) -> Result<(), Error> {
-    match m.patch_size {
-        Some(ps) if !(ps > 0.0 && ps.is_finite()) => Err(Error::Invalid(format!(
-            "--patch-size must be a positive length in metres, got {ps}"
-        ))),
-        _ => Ok(()),
-    }
-}
-
 /// Runs the cross-check; the bar's verdict is in the report (`passed`), not an error.
 pub fn crosscheck(job: &CrossJob) -> Result<CrossCheck, Error> {
-    check_patch_size(&job.mesh)?;
+    job.mesh.check()?;
     if job.rays == 0 {
         return Err(Error::Invalid("--rays must be at least 1".into()));
     }
@@ -61,8 +53,7 @@ pub fn crosscheck(job: &CrossJob) -> Result<CrossCheck, Error> {
             job.eps
         )));
     }
-    let scene = load_scene(&job.source, &job.load)?;
-    let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
+    let Model { scene, mesh: m } = Model::load(&job.source, &job.load, &job.mesh)?;
     if m.patches.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no patches to cast at",
@@ -126,7 +117,7 @@ pub fn bench_intersect(
     job: &BenchJob,
     mut log: impl FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, Error> {
-    check_patch_size(&job.mesh)?;
+    job.mesh.check()?;
     if job.rays == 0 {
         return Err(Error::Invalid("--rays must be at least 1".into()));
     }
@@ -142,16 +133,13 @@ pub fn bench_intersect(
     let (rays, seed, from) = (job.rays, job.seed, job.rays_from);
     let mut rows = Vec::new();
     for source in &job.scenes {
-        let scene = load_scene(source, &job.load)?;
-        let m = crate::pipeline::build_mesh(&scene, &job.mesh)?;
-        let row = bench::bench_mesh(&scene.name, &m, rays, seed, from)?;
+        let model = Model::load(source, &job.load, &job.mesh)?;
+        let row = bench::bench_mesh(&model.scene.name, &model.mesh, rays, seed, from)?;
         log(&row);
         rows.push(row);
     }
     for &n in &job.generated {
-        let scene = generated_building(n)?;
-        let m = crate::pipeline::build_mesh(&scene, &MeshOptions::default())?;
-        drop(scene);
+        let m = Model::from_scene(generated_building(n)?, &MeshOptions::default())?.mesh;
         let row = bench::bench_mesh(&format!("building-{}", short(n)), &m, rays, seed, from)?;
         log(&row);
         rows.push(row);

@@ -1,4 +1,9 @@
-//! What a run reports: the JSON summary of a solve and the description of a scene (`info`).
+//! What a run reports: the JSON summary of a solve and the description of a scene (`info`);
+//! [`trace`] writes the error-against-time log (`trace.csv`), [`plot`] draws every plot
+//! (compare's error against time, decay and cost per shot; the sweep's growth).
+
+pub mod plot;
+pub mod trace;
 
 use crate::intersect::select;
 use crate::mesh::{Mesh, PatchClass};
@@ -259,6 +264,9 @@ pub struct Summary {
     pub max_unshot_over_mean: f64,
     pub warnings: Vec<String>,
     pub outputs: Vec<String>,
+    /// Every setting that shaped the result (`pipeline::RunSettings`), derived, not listed by
+    /// hand: `load`, `mesh`, `solve`, `intersector`, `per_light`.
+    pub settings: serde_json::Value,
     /// The max-unshot trace, against time and shots.
     pub trace: Vec<TracePoint>,
 }

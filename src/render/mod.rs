@@ -1,4 +1,5 @@
-//! Display of a radiosity solution: camera, CPU rasterizer and tone mapping.
+//! Display of a radiosity solution: camera, CPU rasterizer and tone mapping; [`false_colour`]
+//! (irradiance on a log scale with a legend) and [`glyphs`] (the legend's digits) beside it.
 //!
 //! The paper shows its solutions the classic way: radiosity is averaged to the patch vertices
 //! and Gouraud-interpolated across each patch. [`render_linear`] does exactly that in software:
@@ -16,6 +17,12 @@
 //! two tasks write the same memory and the result does not depend on scheduling.
 //! Rasterization is watertight: each shared edge is evaluated with its endpoints in a canonical
 //! order and clipped from its inside endpoint, so neighbouring triangles leave no cracks.
+
+pub mod false_colour;
+pub mod glyphs;
+pub mod view;
+
+pub use view::{CameraSpec, ViewSettings};
 
 use crate::mesh::Mesh;
 use glam::Vec3;
@@ -77,7 +84,8 @@ impl Camera {
 }
 
 /// Output size and quality of [`render_linear`].
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default)]
 pub struct RenderOptions {
     pub width: u32,
     pub height: u32,
@@ -90,9 +98,9 @@ pub struct RenderOptions {
 impl Default for RenderOptions {
     fn default() -> Self {
         RenderOptions {
-            width: 640,
-            height: 480,
-            supersample: 3,
+            width: view::DEFAULT_WIDTH,
+            height: view::DEFAULT_HEIGHT,
+            supersample: view::DEFAULT_SUPERSAMPLE,
             exposure: None,
         }
     }

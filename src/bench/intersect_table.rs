@@ -5,13 +5,13 @@
 //! all threads (rayon) after a short warm-up. Mrays/s counts closest-hit queries; building the
 //! structures is timed apart. A benchmark, not a test: nothing asserts on its figures.
 
-use super::brute::BruteForce;
 use super::crosscheck::{RayGen, RaySource, TestRay, BRUTE_MAX_PATCHES};
-use super::embree::{set_flush_denormals, EmbreeError, EmbreeScene};
-use super::hybrid::Hybrid;
-use super::plane_merge::PlaneMerge;
-use super::select::SceneShape;
-use super::{Intersector, Ray};
+use crate::intersect::brute::BruteForce;
+use crate::intersect::embree::{set_flush_denormals, EmbreeError, EmbreeScene};
+use crate::intersect::hybrid::Hybrid;
+use crate::intersect::plane_merge::PlaneMerge;
+use crate::intersect::select::SceneShape;
+use crate::intersect::{Intersector, Ray};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 use std::fmt::Write as _;

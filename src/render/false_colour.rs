@@ -10,8 +10,8 @@
 //! ends rounded to 1–2–5 steps. The legend is a panel of [`LEGEND_WIDTH`] pixels appended on
 //! the right, so it never hides the scene.
 
-use crate::export::solution::SavedSolution;
-use crate::glyphs;
+use crate::mesh::Mesh;
+use crate::render::glyphs;
 use crate::render::{self, Camera, RenderOptions};
 
 /// Width of the legend panel to the right of the picture, pixels.
@@ -139,30 +139,16 @@ fn trim(v: f64) -> String {
     s.to_string()
 }
 
-/// Irradiance per patch (W/m²), `None` where the material reflects nothing.
-pub fn patch_irradiance(sol: &SavedSolution) -> Vec<Option<f64>> {
-    const LUMA: [f64; 3] = [0.2126, 0.7152, 0.0722];
-    (0..sol.mesh.patches.len())
-        .map(|i| {
-            let mat = &sol.meta.materials[sol.mesh.patches[i].material as usize];
-            let e = sol.emission(i);
-            let (mut sum, mut w) = (0.0, 0.0);
-            for c in 0..3 {
-                if mat.rho[c] > 0.0 {
-                    sum += LUMA[c] * (sol.b[i][c] - e[c]) / mat.rho[c];
-                    w += LUMA[c];
-                }
-            }
-            (w > 0.0)
-                .then(|| (sum / w).max(0.0))
-                .filter(|h| h.is_finite())
-        })
-        .collect()
-}
-
 /// The false-colour picture (with its legend panel) and the scale used.
-pub fn render(sol: &SavedSolution, cam: &Camera, opts: &RenderOptions) -> (image::RgbImage, Scale) {
-    let h = patch_irradiance(sol);
+/// `irradiance` holds one value per patch of `mesh` (W/m²; `None` where it is unknown, as on
+/// a material that reflects nothing).
+pub fn render(
+    mesh: &Mesh,
+    irradiance: &[Option<f64>],
+    cam: &Camera,
+    opts: &RenderOptions,
+) -> (image::RgbImage, Scale) {
+    let h = irradiance;
     // Three channels interpolate together: irradiance × known, coverage (1), known. Their
     // ratios per pixel give the mean irradiance of the known surfaces, the share of the pixel
     // covered (anti-aliased edges) and the share whose irradiance is known.
@@ -173,8 +159,8 @@ pub fn render(sol: &SavedSolution, cam: &Camera, opts: &RenderOptions) -> (image
             None => [0.0, 1.0, 0.0],
         })
         .collect();
-    let vertex = sol.mesh.vertex_values(&per_patch);
-    let lin = render::render_linear(&sol.mesh, &vertex, cam, opts);
+    let vertex = mesh.vertex_values(&per_patch);
+    let lin = render::render_linear(mesh, &vertex, cam, opts);
     let value = |p: &[f32; 3]| (p[2] > 0.5 * p[1] && p[1] > 1e-6).then(|| (p[0] / p[2]) as f64);
     let mut seen: Vec<f64> = lin.pixels.iter().filter_map(value).collect();
     let scale = Scale::fit(&mut seen);

@@ -10,14 +10,15 @@
 //! Each building is written to a file and loaded from it, as a user would; the file is removed
 //! afterwards.
 
-use crate::compare::plot::{self, Curve};
 use crate::export::write_atomic;
 use crate::generate::{self, BuildingOptions};
-use crate::intersect::select::{self, IntersectorKind};
+use crate::intersect::select::IntersectorKind;
 use crate::intersect::Intersector;
 use crate::mesh::MeshOptions;
+use crate::model::Model;
+use crate::report::plot::{self, Curve};
 use crate::scene::{self, LoadOptions};
-use crate::solve::{self, MethodKind, SolveSettings};
+use crate::solve::{MethodKind, SolveSettings};
 use crate::Error;
 use serde::Serialize;
 use std::io::Write;
@@ -35,6 +36,20 @@ pub struct SweepJob {
     /// Output folder.
     pub out: PathBuf,
     pub seed: u64,
+}
+
+impl SweepJob {
+    /// Refuses what `solve` refuses (the same settings check) and an empty or absurd size list.
+    pub fn check(&self) -> Result<(), crate::settings::Invalid> {
+        self.cfg.check()?;
+        if self.sizes.is_empty() {
+            return crate::settings::Invalid::err("--sizes names no size");
+        }
+        if self.methods.is_empty() {
+            return crate::settings::Invalid::err("--methods names no method");
+        }
+        Ok(())
+    }
 }
 
 /// One (size, method) run.
@@ -102,6 +117,7 @@ pub fn growth_exponent(points: &[(f64, f64)]) -> Option<f64> {
 
 /// Runs the sweep; `log` hears one line per run.
 pub fn run(job: &SweepJob, mut log: impl FnMut(&str)) -> Result<Vec<SweepRow>, Error> {
+    job.check()?;
     crate::export::prepare_dir(&job.out)?;
     let mut rows = Vec::new();
     for &target in &job.sizes {
@@ -165,12 +181,13 @@ fn run_one(
     let scene = scene::load_obj(obj, &LoadOptions::default())?;
     let load_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let m = crate::pipeline::build_mesh(&scene, &MeshOptions::default())?;
+    let model = Model::from_scene(scene, &MeshOptions::default())?;
+    let m = &model.mesh;
     let mesh_s = t.elapsed().as_secs_f64();
     let (before, _) = rss_kib();
     let t = Instant::now();
     let isect = if method.casts_rays() {
-        Some(select::select(&m, job.intersector)?.0)
+        Some(model.intersector(job.intersector)?.0)
     } else {
         None
     };
@@ -180,18 +197,7 @@ fn run_one(
         method,
         ..job.cfg.clone()
     };
-    let sol = solve::run(
-        &m,
-        &scene.materials,
-        isect.as_ref(),
-        &cfg,
-        &Default::default(),
-        |_| {},
-    )
-    .map_err(|source| Error::Solve {
-        scene: format!("generated building of {} patches", m.patches.len()),
-        source,
-    })?;
+    let sol = model.solve(isect.as_ref(), &cfg, &Default::default(), |_| {})?;
     let (_, peak) = rss_kib();
     let embree = (after - before).max(0.0);
     let est = sol

@@ -21,12 +21,12 @@
 //! Everything runs in parallel over chunks of rays whose random numbers come from (seed,
 //! chunk), and the chunks' results are combined in order, so a report depends on the seed only.
 
-use super::brute::BruteForce;
-use super::embree::{set_flush_denormals, EmbreeError, EmbreeScene};
-use super::hybrid::Hybrid;
-use super::plane_merge::PlaneMerge;
-use super::select::AnyIntersector;
-use super::{Hit, Intersector, Ray};
+use crate::intersect::brute::BruteForce;
+use crate::intersect::embree::{set_flush_denormals, EmbreeError, EmbreeScene};
+use crate::intersect::hybrid::Hybrid;
+use crate::intersect::plane_merge::PlaneMerge;
+use crate::intersect::select::AnyIntersector;
+use crate::intersect::{Hit, Intersector, Ray};
 use crate::mesh::{Mesh, PatchClass};
 use crate::sample::Frame;
 use glam::{DVec3, Vec3};

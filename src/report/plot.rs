@@ -1,16 +1,8 @@
-//! The plots of a comparison, as PNG bytes (plotters' bitmap backend; text by ab_glyph from a
-//! font that ships in a crate, so no system fonts are needed):
-//!
-//! - `error_vs_time.png`: average weighted percent error against seconds, log–log, one curve
-//!   per method (Sec. 4's speedups at equal error are horizontal distances here);
-//! - `decay.png`: max unshot radiosity relative to its start against percent of shots, log y,
-//!   with each method's fitted decay constant E (Fig. 2);
-//! - `cost_per_shot.png`: seconds per shot against percent of shots, log y (Fig. 5).
+//! Every plot the tool draws, as PNG bytes: [`draw`] of [`Curve`]s, on plotters' bitmap
+//! backend, with text by ab_glyph from a font that ships in a crate (no system fonts needed).
+//! `radiosity compare` draws error against time, Fig. 2's decay and Fig. 5's cost per shot
+//! (`compare::report::plots`); `radiosity sweep` draws time and memory against patches.
 
-use super::analysis;
-use super::report::decay_of;
-use super::{Comparison, MethodRun};
-use crate::solve::MethodKind;
 use crate::Error;
 use plotters::prelude::*;
 use std::sync::Once;
@@ -63,13 +55,13 @@ fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f64> {
 }
 
 /// One curve per method.
-pub(crate) struct Curve {
+pub struct Curve {
     pub label: String,
     pub points: Vec<(f64, f64)>,
 }
 
 /// Draws curves on a chart with a log y axis (and a log x axis if `log_x`) into PNG bytes.
-pub(crate) fn draw(
+pub fn draw(
     title: &str,
     x_desc: &str,
     y_desc: &str,
@@ -151,72 +143,4 @@ pub(crate) fn draw(
     );
     img.write_with_encoder(encoder).map_err(plot_error)?;
     Ok(png)
-}
-
-fn shooters(cmp: &Comparison) -> impl Iterator<Item = &MethodRun> {
-    cmp.runs
-        .iter()
-        .filter(|r| r.method != MethodKind::Gathering)
-}
-
-/// The three plots, as (file name, PNG bytes).
-pub fn all(cmp: &Comparison) -> Result<Vec<(&'static str, Vec<u8>)>, Error> {
-    let errors: Vec<Curve> = cmp
-        .runs
-        .iter()
-        .map(|r| Curve {
-            label: r.method.name().into(),
-            points: analysis::weighted_percent_series(&r.trace)
-                .into_iter()
-                .map(|(t, e)| (t, 100.0 * e))
-                .collect(),
-        })
-        .collect();
-    let decay: Vec<Curve> = shooters(cmp)
-        .map(|r| Curve {
-            label: match decay_of(r) {
-                Some(e) => format!("{} (E = {e:.4})", r.method.name()),
-                None => r.method.name().into(),
-            },
-            points: analysis::decay_curve(&r.trace),
-        })
-        .collect();
-    let cost: Vec<Curve> = shooters(cmp)
-        .map(|r| Curve {
-            label: r.method.name().into(),
-            points: analysis::cost_per_shot(&r.trace),
-        })
-        .collect();
-    Ok(vec![
-        (
-            "error_vs_time.png",
-            draw(
-                &format!("{}: error against time", cmp.scene),
-                "seconds",
-                "average weighted percent error (%)",
-                &errors,
-                true,
-            )?,
-        ),
-        (
-            "decay.png",
-            draw(
-                &format!("{}: max unshot radiosity (Fig. 2)", cmp.scene),
-                "percent of shots",
-                "max unshot / its start",
-                &decay,
-                false,
-            )?,
-        ),
-        (
-            "cost_per_shot.png",
-            draw(
-                &format!("{}: cost per shot (Fig. 5)", cmp.scene),
-                "percent of shots",
-                "seconds per shot",
-                &cost,
-                false,
-            )?,
-        ),
-    ])
 }

@@ -1,6 +1,6 @@
 //! `radiosity render` and `radiosity export`: read a saved solution
 //! ([`crate::export::solution`]) and write one image or one mesh, without the OBJ and without
-//! solving again. The format follows the extension of `--out` (DESIGN.md §5).
+//! solving again. The format follows the extension of `--out` (docs/design.md §5).
 //!
 //! Given the scene too (`--scene`), the solution is checked against it first and refused when
 //! it belongs to another scene or other mesh settings.
@@ -8,10 +8,10 @@
 use crate::export::image::{self as image_out, ImageKind};
 use crate::export::solution::{self, SavedSolution};
 use crate::export::{glb, ply, write_atomic};
-use crate::false_colour::{self, Scale};
-use crate::pipeline::{load_scene, CameraSpec, SceneSource};
-use crate::render::{self, RenderOptions};
+use crate::render::false_colour::{self, Scale};
+use crate::render::{self, ViewSettings};
 use crate::scene::LoadOptions;
+use crate::scene::SceneSource;
 use crate::Error;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -34,8 +34,7 @@ pub struct RenderJob {
     pub check: Option<SceneCheck>,
     /// `.png`, `.hdr` or `.exr`.
     pub out: PathBuf,
-    pub camera: CameraSpec,
-    pub render: RenderOptions,
+    pub view: ViewSettings,
     /// Irradiance in false colour with a legend (PNG only).
     pub false_colour: bool,
 }
@@ -70,7 +69,7 @@ pub struct OutputReport {
 pub fn load_checked(path: &Path, check: Option<&SceneCheck>) -> Result<SavedSolution, Error> {
     let sol = SavedSolution::load(path)?;
     if let Some(c) = check {
-        let scene = load_scene(&c.source, &c.load)?;
+        let scene = c.source.load(&c.load)?;
         let two_sided = c.two_sided.unwrap_or(sol.meta.two_sided);
         let patch_size = c.patch_size.unwrap_or(sol.meta.patch_size);
         let hash = solution::scene_hash(&scene, patch_size, two_sided);
@@ -91,21 +90,7 @@ fn check_render_options(job: &RenderJob) -> Result<ImageKind, Error> {
             "--false-colour draws a display image: use --out FILE.png".into(),
         ));
     }
-    let r = &job.render;
-    if r.width == 0 || r.height == 0 || r.width > 16384 || r.height > 16384 {
-        return Err(Error::Invalid(format!(
-            "--width and --height must be between 1 and 16384, got {}x{}",
-            r.width, r.height
-        )));
-    }
-    job.camera.check().map_err(Error::Invalid)?;
-    if let Some(e) = r.exposure {
-        if !(e > 0.0 && e.is_finite()) {
-            return Err(Error::Invalid(format!(
-                "--exposure must be a positive number, got {e}"
-            )));
-        }
-    }
+    job.view.check()?;
     Ok(kind)
 }
 
@@ -138,19 +123,18 @@ fn render_loaded(
     job: &RenderJob,
 ) -> Result<OutputReport, Error> {
     let (lo, hi) = bounds(sol);
-    let aspect = job.render.width as f32 / job.render.height as f32;
-    let cam = job.camera.resolve(lo, hi, aspect);
+    let cam = job.view.camera_for(lo, hi);
     let mut exposure = None;
     let mut scale = None;
     if job.false_colour {
-        let (img, s) = false_colour::render(sol, &cam, &job.render);
+        let (img, s) = false_colour::render(&sol.mesh, &sol.irradiance(), &cam, &job.view.image);
         scale = Some(s);
         write_atomic(&job.out, |w| image_out::write_png(w, &img))?;
     } else {
-        let lin = render::render_linear(&sol.mesh, &sol.vertex_b, &cam, &job.render);
+        let lin = render::render_linear(&sol.mesh, &sol.vertex_b, &cam, &job.view.image);
         match kind {
             ImageKind::Png => {
-                let (img, e) = render::tone_map(&lin, job.render.exposure);
+                let (img, e) = render::tone_map(&lin, job.view.image.exposure);
                 exposure = Some(e);
                 write_atomic(&job.out, |w| image_out::write_png(w, &img))?;
             }
@@ -300,7 +284,7 @@ pub fn run_relight(job: &RelightJob) -> Result<OutputReport, Error> {
             solution: job.render.solution.clone(),
             check: job.render.check.clone(),
             out: job.render.out.clone(),
-            exposure: job.render.render.exposure,
+            exposure: job.render.view.image.exposure,
         };
         let sol = load_checked(&export.solution, export.check.as_ref())?;
         return export_loaded(&relight(&sol, &job.weights)?, f.to_string(), &export);

@@ -1,0 +1,14 @@
+//! Benchmarks and cross-checks, run by hand and reported in the README (never timed
+//! assertions in tests):
+//!
+//! - [`crosscheck`]: every intersector against a reference on the same rays (issue 4);
+//! - [`intersect`]: the jobs of `radiosity crosscheck` and `radiosity bench intersect`;
+//!   [`intersect_table`] their Markdown and CSV;
+//! - [`rays`]: raw Embree throughput against the solver's (`radiosity bench rays`);
+//! - [`sweep`]: the scene-size performance sweep over generated buildings (`radiosity sweep`).
+
+pub mod crosscheck;
+pub mod intersect;
+pub mod intersect_table;
+pub mod rays;
+pub mod sweep;

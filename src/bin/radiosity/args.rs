@@ -1,0 +1,362 @@
+//! Flag groups shared by several commands, each declared once, and the values they parse to.
+//! Defaults are the library's constants; every range check is the library's (the settings
+//! types check themselves), so the commands refuse the same values with the same words.
+
+use clap::Args;
+use glam::Vec3;
+use radiosity::intersect::select::IntersectorKind;
+use radiosity::mesh::MeshOptions;
+use radiosity::render::view::{DEFAULT_HEIGHT, DEFAULT_SUPERSAMPLE, DEFAULT_WIDTH};
+use radiosity::render::{CameraSpec, RenderOptions, ViewSettings};
+use radiosity::saved::SceneCheck;
+use radiosity::scene::{LoadOptions, SceneSource};
+use radiosity::solve::lights::GroupBy;
+use radiosity::solve::settings::{DEFAULT_GATHER_CAP_MIB, DEFAULT_HEMICUBE_N};
+use radiosity::solve::{MethodKind, SolveSettings};
+use std::path::PathBuf;
+
+/// How the scene is read and cut into patches.
+#[derive(Args, Clone)]
+pub struct SceneArgs {
+    /// Make a material emit: MATERIAL=R,G,B emitted radiance in W/sr/m² (the unit of MTL Ke);
+    /// repeatable. For models that ship without Ke.
+    #[arg(long, value_name = "MATERIAL=R,G,B", value_parser = parse_emit)]
+    pub emit: Vec<(String, [f64; 3])>,
+    /// Longest patch edge in metres (default: derived from the scene, and printed).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub patch_size: Option<f32>,
+    /// Give every polygon a back patch of its own (thin surfaces lit from both sides).
+    #[arg(long)]
+    pub two_sided: bool,
+}
+
+impl SceneArgs {
+    pub fn load(&self) -> LoadOptions {
+        LoadOptions {
+            emit: self.emit.clone(),
+        }
+    }
+    pub fn mesh(&self) -> MeshOptions {
+        MeshOptions {
+            patch_size: self.patch_size,
+            two_sided: self.two_sided,
+        }
+    }
+}
+
+/// The optional scene argument: a file, or the built-in Cornell box.
+pub fn source(scene: Option<PathBuf>) -> SceneSource {
+    SceneSource::from_arg(scene)
+}
+
+/// How form factors are sampled: the settings every command that solves shares (`solve`,
+/// `compare`, `reference`, `sweep`, `bench rays`, `bench shots`). Left out, a value takes the
+/// command's own default (the solver's, or the reference's for `radiosity reference`).
+#[derive(Args, Clone)]
+pub struct SamplingArgs {
+    /// Seed of all random choices; the same seed gives the same result on any run and thread
+    /// count [default: 1].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Relative sampling error wanted for a typical patch's radiosity. Sets the energy each ray
+    /// carries (Sec. 2: rays in proportion to unshot energy): about patches/tolerance² rays in
+    /// all, so halving it costs 4× the rays [default: 0.05; reference: 0.005].
+    #[arg(long, allow_negative_numbers = true)]
+    pub tolerance: Option<f64>,
+    /// Energy per ray C in watts (overrides --tolerance).
+    #[arg(long, value_name = "WATTS", allow_negative_numbers = true)]
+    pub energy_per_ray: Option<f64>,
+    /// Stop when the max unshot radiosity is below this fraction of the mean radiosity
+    /// (paper Sec. 3) [default: 0.0006; reference: 1e-5].
+    #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
+    pub stop: Option<f64>,
+    /// Aim rays at the centres of the polar cells, as the paper does, instead of at random
+    /// points inside them (biased at low ray counts; for comparison).
+    #[arg(long)]
+    pub polar_centres: bool,
+    /// Resolution N of the uniform N×N hemi-cube (methods hemicube, hemicube-jittered,
+    /// gathering).
+    #[arg(long, default_value_t = DEFAULT_HEMICUBE_N, value_name = "N")]
+    pub hemicube_n: usize,
+    /// Gathering refuses scenes whose form-factor matrix needs more memory than this.
+    #[arg(long, default_value_t = DEFAULT_GATHER_CAP_MIB, value_name = "MIB")]
+    pub gather_cap_mib: u64,
+    /// Ray intersector: auto picks per scene (the rule is in `radiosity info`); merge needs a
+    /// scene whose patches are all axis-aligned.
+    #[arg(long, value_enum, default_value_t = IntersectorArg::Auto)]
+    pub intersector: IntersectorArg,
+}
+
+impl SamplingArgs {
+    /// These flags over `base` (the command's defaults).
+    pub fn over(&self, base: SolveSettings) -> SolveSettings {
+        SolveSettings {
+            seed: self.seed.unwrap_or(base.seed),
+            tolerance: self.tolerance.unwrap_or(base.tolerance),
+            energy_per_ray: self.energy_per_ray.or(base.energy_per_ray),
+            stop_fraction: self.stop.unwrap_or(base.stop_fraction),
+            jitter: base.jitter && !self.polar_centres,
+            hemicube_n: self.hemicube_n,
+            gather_cap_mib: self.gather_cap_mib,
+            ..base
+        }
+    }
+}
+
+/// The method and the budgets of one solve.
+#[derive(Args, Clone)]
+pub struct SolverArgs {
+    #[command(flatten)]
+    pub sampling: SamplingArgs,
+    /// Stop after this many seconds of solving, whatever the criterion says.
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    pub max_time: Option<f64>,
+    /// Stop after about this many form-factor samples (rays, plus hemi-cube cells).
+    #[arg(long)]
+    pub max_rays: Option<u64>,
+    /// How form factors are sampled.
+    #[arg(long, value_enum, default_value_t = Method::AdaptiveHybrid)]
+    pub method: Method,
+    /// adaptive-hybrid: switch from hemi-cubes to rays at this shot instead of when the cost
+    /// model says so (the switch shot a summary.json recorded).
+    #[arg(long, value_name = "SHOT")]
+    pub switch_at: Option<u64>,
+}
+
+impl SolverArgs {
+    pub fn settings(&self) -> SolveSettings {
+        SolveSettings {
+            method: self.method.into(),
+            max_time: self.max_time,
+            max_rays: self.max_rays,
+            switch_at: self.switch_at,
+            ..self.sampling.over(SolveSettings::default())
+        }
+    }
+
+    pub fn intersector(&self) -> IntersectorKind {
+        self.sampling.intersector.into()
+    }
+}
+
+/// The camera and the image (`solve`, `render`, `relight`).
+#[derive(Args)]
+pub struct ViewArgs {
+    /// Camera position X,Y,Z (default: fitted to the scene, looking along −z).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<Vec3>,
+    /// Point the camera looks at X,Y,Z (default: the scene's centre).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<Vec3>,
+    /// Camera up direction X,Y,Z (default 0,1,0).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<Vec3>,
+    /// Vertical field of view in degrees.
+    #[arg(long, allow_negative_numbers = true)]
+    pub fov: Option<f32>,
+    #[arg(long, default_value_t = DEFAULT_WIDTH)]
+    pub width: u32,
+    #[arg(long, default_value_t = DEFAULT_HEIGHT)]
+    pub height: u32,
+    /// Samples per pixel along each axis (edges anti-aliased by s×s supersampling).
+    #[arg(long, default_value_t = DEFAULT_SUPERSAMPLE)]
+    pub supersample: u32,
+    /// Exposure multiplier on radiosity for PNG (default: automatic).
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
+}
+
+impl ViewArgs {
+    pub fn settings(&self) -> ViewSettings {
+        ViewSettings {
+            camera: CameraSpec {
+                eye: self.eye,
+                target: self.target,
+                up: self.up,
+                fov_y_deg: self.fov,
+            },
+            image: RenderOptions {
+                width: self.width,
+                height: self.height,
+                supersample: self.supersample,
+                exposure: self.exposure,
+            },
+        }
+    }
+}
+
+/// Checking a saved solution against its scene (optional).
+#[derive(Args, Clone)]
+pub struct CheckArgs {
+    /// Refuse the solution unless it was solved on this OBJ (same geometry and reflectances;
+    /// emission may differ).
+    #[arg(long, value_name = "FILE.obj")]
+    pub scene: Option<PathBuf>,
+    /// With --scene: the patch size to check too (default: the solution's own).
+    #[arg(long, value_name = "METRES", requires = "scene")]
+    pub check_patch_size: Option<f32>,
+}
+
+impl CheckArgs {
+    pub fn check(&self) -> Option<SceneCheck> {
+        self.scene.as_ref().map(|p| SceneCheck {
+            source: SceneSource::File(p.clone()),
+            load: LoadOptions::default(),
+            patch_size: self.check_patch_size,
+            two_sided: None,
+        })
+    }
+}
+
+/// `--intersector`: see `radiosity::intersect::select::IntersectorKind`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum IntersectorArg {
+    Auto,
+    Embree,
+    Merge,
+    Hybrid,
+}
+
+impl From<IntersectorArg> for IntersectorKind {
+    fn from(a: IntersectorArg) -> IntersectorKind {
+        match a {
+            IntersectorArg::Auto => IntersectorKind::Auto,
+            IntersectorArg::Embree => IntersectorKind::Embree,
+            IntersectorArg::Merge => IntersectorKind::Merge,
+            IntersectorArg::Hybrid => IntersectorKind::Hybrid,
+        }
+    }
+}
+
+/// `--method`: see `radiosity::solve::MethodKind`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum Method {
+    /// Shooting with the paper's adaptive polar hemisphere ray sampler (Sec. 2).
+    AdaptiveRays,
+    /// Shooting with the uniform N×N hemi-cube (Cohen & Greenberg 1985): the baseline.
+    Hemicube,
+    /// The uniform hemi-cube with jittered sample points (the paper's Table 1).
+    HemicubeJittered,
+    /// Shooting with the paper's non-uniform hemi-cube, resolution from the unshot energy.
+    AdaptiveHemicube,
+    /// Adaptive hemi-cube first, adaptive rays once cheaper by the cost model (Sec. 4).
+    AdaptiveHybrid,
+    /// The traditional algorithm: full form-factor matrix, then Gauss–Seidel.
+    Gathering,
+}
+
+impl From<Method> for MethodKind {
+    fn from(m: Method) -> MethodKind {
+        match m {
+            Method::AdaptiveRays => MethodKind::AdaptiveRays,
+            Method::Hemicube => MethodKind::Hemicube,
+            Method::HemicubeJittered => MethodKind::HemicubeJittered,
+            Method::AdaptiveHemicube => MethodKind::AdaptiveHemicube,
+            Method::AdaptiveHybrid => MethodKind::AdaptiveHybrid,
+            Method::Gathering => MethodKind::Gathering,
+        }
+    }
+}
+
+/// `--light-groups`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum LightGroupsArg {
+    /// One channel per emitting material.
+    Material,
+    /// One channel per connected emitting surface (fixtures of one material apart).
+    Connected,
+}
+
+impl From<LightGroupsArg> for GroupBy {
+    fn from(a: LightGroupsArg) -> Self {
+        match a {
+            LightGroupsArg::Material => GroupBy::Material,
+            LightGroupsArg::Connected => GroupBy::Connected,
+        }
+    }
+}
+
+/// A list of patch counts.
+#[derive(Clone)]
+pub struct Sizes(pub Vec<usize>);
+
+pub fn parse_sizes(s: &str) -> Result<Sizes, String> {
+    if s.trim().is_empty() || s.trim() == "none" {
+        return Ok(Sizes(Vec::new()));
+    }
+    s.split(',')
+        .map(|p| {
+            let p = p.trim();
+            let (num, mul) = match p.chars().last() {
+                Some('k' | 'K') => (&p[..p.len() - 1], 1_000.0),
+                Some('M' | 'm') => (&p[..p.len() - 1], 1_000_000.0),
+                _ => (p, 1.0),
+            };
+            match num.parse::<f64>() {
+                Ok(v) if v > 0.0 && (v * mul) <= 1e7 => Ok((v * mul).round() as usize),
+                _ => Err(format!(
+                    "'{p}' is not a patch count between 1 and 10M (like 1000, 10k or 1M)"
+                )),
+            }
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Sizes)
+}
+
+fn parse_floats<const N: usize>(s: &str) -> Result<[f64; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!("expected {N} comma-separated numbers, got '{s}'"));
+    }
+    let mut out = [0.0; N];
+    for (o, p) in out.iter_mut().zip(parts) {
+        let v: f64 = p
+            .trim()
+            .parse()
+            .map_err(|_| format!("'{p}' is not a number"))?;
+        if !v.is_finite() {
+            return Err(format!("'{p}' is not a finite number"));
+        }
+        *o = v;
+    }
+    Ok(out)
+}
+
+pub fn parse_threads(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "'{s}' is not a thread count of at least 1 (leave --threads out for all cores)"
+        )),
+    }
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let v = parse_floats::<3>(s)?;
+    Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
+}
+
+fn parse_emit(s: &str) -> Result<(String, [f64; 3]), String> {
+    let (name, rgb) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected MATERIAL=R,G,B, got '{s}'"))?;
+    let rgb = parse_floats::<3>(rgb)?;
+    if rgb.iter().any(|&x| x < 0.0) {
+        return Err(format!("emission must not be negative, got '{s}'"));
+    }
+    Ok((name.to_string(), rgb))
+}
+
+pub fn parse_weight(s: &str) -> Result<(String, f64), String> {
+    let (name, w) = s
+        .rsplit_once('=')
+        .ok_or_else(|| format!("expected LIGHT=WEIGHT, got '{s}'"))?;
+    let w: f64 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{w}' is not a number in '{s}'"))?;
+    if !(w.is_finite() && w >= 0.0) {
+        return Err(format!("the weight in '{s}' must be a finite number ≥ 0"));
+    }
+    Ok((name.trim().to_string(), w))
+}

@@ -1,0 +1,295 @@
+//! Benchmarks and cross-checks: `radiosity bench …`, `radiosity crosscheck`, `radiosity sweep`.
+
+use crate::args::{parse_sizes, source, Method, SceneArgs, Sizes, SolverArgs};
+use crate::{out, outln};
+use clap::{Args, Subcommand};
+use radiosity::bench::crosscheck::RaySource;
+use radiosity::bench::intersect::{self as intersect_jobs, BenchJob, CrossJob};
+use radiosity::bench::{intersect_table, rays, sweep};
+use radiosity::export::write_atomic;
+use radiosity::scene::SceneSource;
+use radiosity::solve::MethodKind;
+
+use std::path::PathBuf;
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// Mrays/s of Embree (whole scene), the plane merge, the hybrid and brute force, side by
+    /// side on each scene and on generated buildings.
+    Intersect {
+        /// OBJ files (with their MTL beside them).
+        scenes: Vec<PathBuf>,
+        #[command(flatten)]
+        scene_args: SceneArgs,
+        /// Generated buildings of about these many patches (1k = 1000, 1M = 1000000; "none"
+        /// for none). 1M takes minutes and a few GB.
+        #[arg(long, value_parser = parse_sizes, default_value = "1k,10k,100k")]
+        generated: Sizes,
+        /// Rays per intersector and scene (brute force casts fewer).
+        #[arg(long, default_value_t = 1_000_000)]
+        rays: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Which rays: from patch surfaces as the solver casts them, uniform (origin in the
+        /// bounds, direction on the sphere), or half of each.
+        #[arg(long, value_enum, default_value_t = RaysArg::Both)]
+        source: RaysArg,
+        /// Also write the table as CSV to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Raw Embree closest-hit throughput on random rays against the solver's rays per second,
+    /// measured in one run.
+    Rays {
+        scene: Option<PathBuf>,
+        #[command(flatten)]
+        scene_args: SceneArgs,
+        #[command(flatten)]
+        solve_args: SolverArgs,
+        /// Random rays for the raw measurement (a quarter before each solve).
+        #[arg(long, default_value_t = 4_000_000)]
+        rays: u64,
+        /// Solve again (next seeds) until the solves took this long in all, alternating with
+        /// raw measurements, so both see the same machine.
+        #[arg(long, default_value_t = 3.0, value_name = "SECONDS")]
+        min_seconds: f64,
+        /// Also write the figures as JSON to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Cost per shot (Sec. 4): uniform against non-uniform hemi-cubes with the same largest
+    /// delta form factor, ray shots per ray, and where adaptive-hybrid switches.
+    Shots {
+        scene: Option<PathBuf>,
+        #[command(flatten)]
+        scene_args: SceneArgs,
+        #[command(flatten)]
+        solve_args: SolverArgs,
+        /// Uniform hemi-cube resolutions to compare.
+        #[arg(long, value_delimiter = ',', default_value = "25,50,100,200")]
+        resolutions: Vec<usize>,
+        /// Patches to shoot from (spread over the scene), the same for every sampler.
+        #[arg(long, default_value_t = 64)]
+        shooters: usize,
+        /// Also write the figures as JSON to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+/// `bench intersect --source`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum RaysArg {
+    Both,
+    Surface,
+    Uniform,
+}
+
+#[derive(Args)]
+pub struct CrosscheckArgs {
+    /// OBJ file (with its MTL beside it); the built-in Cornell box if left out.
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    scene_args: SceneArgs,
+    /// Rays to cast (half from patch surfaces as the solver casts them, half uniform).
+    #[arg(long)]
+    rays: u64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Edge distance, relative to the scene's diagonal, within which a disagreement counts as
+    /// crossing a patch edge.
+    #[arg(long, default_value_t = 1e-5, allow_negative_numbers = true)]
+    eps: f32,
+    /// The scene is open: rays escaping it do not fail the bar (default: judged by the
+    /// reference's escapes).
+    #[arg(long, conflicts_with = "closed")]
+    open: bool,
+    /// The scene is closed: any escape fails the bar.
+    #[arg(long)]
+    closed: bool,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Also write the report to this file (JSON if it ends in .json, else text).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(Args)]
+pub struct SweepArgs {
+    /// Building sizes in patches (1k = 1000, 1M = 1000000).
+    #[arg(long, value_parser = parse_sizes, default_value = "1k,4k,16k,64k,256k,1M")]
+    sizes: Sizes,
+    /// Methods to run at every size.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "adaptive-hybrid"
+    )]
+    methods: Vec<Method>,
+    #[command(flatten)]
+    solve_args: SolverArgs,
+    /// Output folder (sweep.csv, sweep.md, time.png, memory.png).
+    #[arg(long)]
+    out: PathBuf,
+    /// Seed of the generated buildings.
+    #[arg(long, default_value_t = 1)]
+    building_seed: u64,
+}
+
+pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
+    match c {
+        BenchCommand::Intersect {
+            scenes,
+            scene_args,
+            generated,
+            rays,
+            seed,
+            source: rays_from,
+            out,
+        } => {
+            let job = BenchJob {
+                scenes: scenes.into_iter().map(SceneSource::File).collect(),
+                generated: generated.0,
+                load: scene_args.load(),
+                mesh: scene_args.mesh(),
+                rays,
+                seed,
+                rays_from: match rays_from {
+                    RaysArg::Both => None,
+                    RaysArg::Surface => Some(RaySource::Surface),
+                    RaysArg::Uniform => Some(RaySource::Uniform),
+                },
+            };
+            let rows = intersect_jobs::bench_intersect(&job, |r| {
+                eprintln!(
+                    "{}: {} patches, embree {:.2}, hybrid {:.2} Mrays/s",
+                    r.scene, r.shape.patches, r.embree.mrays, r.hybrid.mrays
+                )
+            })?;
+            out!("{}", intersect_table::markdown(&rows));
+            if let Some(path) = out {
+                let text = intersect_table::csv(&rows);
+                write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
+            }
+            Ok(())
+        }
+        BenchCommand::Rays {
+            scene,
+            scene_args,
+            solve_args,
+            rays,
+            min_seconds,
+            out,
+        } => {
+            let b = rays::bench_rays(
+                &source(scene),
+                &scene_args.load(),
+                &scene_args.mesh(),
+                &solve_args.settings(),
+                solve_args.intersector(),
+                rays,
+                min_seconds,
+            )?;
+            outln!("{}", b.text());
+            if let Some(path) = out {
+                write_json(&path, &b)?;
+            }
+            Ok(())
+        }
+        BenchCommand::Shots {
+            scene,
+            scene_args,
+            solve_args,
+            resolutions,
+            shooters,
+            out,
+        } => {
+            if let Some(&bad) = resolutions.iter().find(|&&n| !(2..=4096).contains(&n)) {
+                return Err(radiosity::Error::Invalid(format!(
+                    "--resolutions must be between 2 and 4096, got {bad}"
+                )));
+            }
+            let b = radiosity::shot_bench::bench_shots(
+                &source(scene),
+                &scene_args.load(),
+                &scene_args.mesh(),
+                &solve_args.settings(),
+                &resolutions,
+                shooters,
+            )?;
+            out!("{}", b.markdown());
+            if let Some(path) = out {
+                write_json(&path, &b)?;
+            }
+            Ok(())
+        }
+    }
+}
+
+fn write_json(path: &std::path::Path, v: &impl serde::Serialize) -> Result<(), radiosity::Error> {
+    write_atomic(path, |w| {
+        serde_json::to_writer_pretty(&mut *w, v).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })?;
+    Ok(())
+}
+
+pub fn sweep(a: SweepArgs) -> Result<(), radiosity::Error> {
+    let job = sweep::SweepJob {
+        sizes: a.sizes.0.clone(),
+        methods: a.methods.iter().copied().map(MethodKind::from).collect(),
+        cfg: a.solve_args.settings(),
+        intersector: a.solve_args.intersector(),
+        out: a.out.clone(),
+        seed: a.building_seed,
+    };
+    let rows = sweep::run(&job, |l| outln!("{l}"))?;
+    outln!("{}", sweep::markdown(&rows, &job.methods));
+    outln!("outputs in {}", a.out.display());
+    Ok(())
+}
+
+pub fn crosscheck(a: CrosscheckArgs) -> Result<(), radiosity::Error> {
+    let job = CrossJob {
+        source: source(a.scene),
+        load: a.scene_args.load(),
+        mesh: a.scene_args.mesh(),
+        rays: a.rays,
+        seed: a.seed,
+        eps: a.eps,
+        closed: match (a.open, a.closed) {
+            (true, _) => Some(false),
+            (_, true) => Some(true),
+            _ => None,
+        },
+    };
+    let c = intersect_jobs::crosscheck(&job)?;
+    let json = serde_json::to_string_pretty(&c).unwrap_or_default();
+    if a.json {
+        outln!("{json}");
+    } else {
+        out!("{c}");
+    }
+    if let Some(path) = a.out {
+        let text = if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            json + "\n"
+        } else {
+            c.to_string()
+        };
+        write_atomic(&path, |w| w.write_all(text.as_bytes()))?;
+    }
+    if c.report.passed {
+        Ok(())
+    } else {
+        Err(radiosity::Error::Failed(format!(
+            "{}: the cross-check bar failed: {}",
+            c.scene,
+            c.report.failures.join("; ")
+        )))
+    }
+}

@@ -1,0 +1,120 @@
+//! The commands that act on a saved solution (`solve --save`): `render`, `export`, `relight`.
+
+use crate::args::{parse_weight, CheckArgs, ViewArgs};
+use crate::outln;
+use clap::Args;
+use radiosity::saved::{self, ExportJob, OutputReport, RelightJob, RenderJob};
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// The saved solution (`radiosity solve --save FILE.rad`).
+    solution: PathBuf,
+    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiosity, W/m²).
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    check: CheckArgs,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Irradiance in false colour on a log scale, with a legend in W/m² (PNG only).
+    #[arg(long, alias = "false-color")]
+    false_colour: bool,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+impl RenderArgs {
+    fn job(&self) -> RenderJob {
+        RenderJob {
+            solution: self.solution.clone(),
+            check: self.check.check(),
+            out: self.out.clone(),
+            view: self.view.settings(),
+            false_colour: self.false_colour,
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct ExportArgs {
+    /// The saved solution (`radiosity solve --save FILE.rad`).
+    solution: PathBuf,
+    /// Mesh to write: .ply or .glb.
+    #[arg(long)]
+    out: PathBuf,
+    #[command(flatten)]
+    check: CheckArgs,
+    /// Exposure of the display colours (default: automatic, as for images).
+    #[arg(long, allow_negative_numbers = true)]
+    exposure: Option<f32>,
+    /// Print the report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+}
+
+#[derive(Args)]
+pub struct RelightArgs {
+    /// LIGHT=WEIGHT (repeatable): scale that light's channel (its name as `solve --per-light`
+    /// printed it); lights not named keep weight 1.
+    #[arg(long = "weight", value_name = "LIGHT=W", value_parser = parse_weight)]
+    weights: Vec<(String, f64)>,
+    #[command(flatten)]
+    render: RenderArgs,
+}
+
+pub fn render(a: RenderArgs) -> Result<(), radiosity::Error> {
+    let r = saved::run_render(&a.job())?;
+    print_report(&r, a.json, a.quiet);
+    Ok(())
+}
+
+pub fn relight(a: RelightArgs) -> Result<(), radiosity::Error> {
+    let job = RelightJob {
+        render: a.render.job(),
+        weights: a.weights,
+    };
+    let r = saved::run_relight(&job)?;
+    print_report(&r, a.render.json, a.render.quiet);
+    Ok(())
+}
+
+pub fn export(a: ExportArgs) -> Result<(), radiosity::Error> {
+    let job = ExportJob {
+        solution: a.solution,
+        check: a.check.check(),
+        out: a.out,
+        exposure: a.exposure,
+    };
+    let r = saved::run_export(&job)?;
+    print_report(&r, a.json, a.quiet);
+    Ok(())
+}
+
+/// The one-line report of `render`, `export` and `relight`, or its JSON.
+fn print_report(r: &OutputReport, json: bool, quiet: bool) {
+    if json {
+        outln!("{}", serde_json::to_string_pretty(r).unwrap_or_default());
+    } else if !quiet {
+        let extra = match (&r.scale, r.exposure) {
+            (Some(s), _) => format!(", irradiance {}–{} W/m² on a log scale", s.lo, s.hi),
+            (None, Some(e)) => format!(", exposure {e:.4}"),
+            (None, None) => ", linear radiosity in W/m²".to_string(),
+        };
+        outln!(
+            "{}: {} of {} ({} patches, {} vertices){extra}",
+            r.out,
+            r.format,
+            r.scene,
+            r.patches,
+            r.vertices
+        );
+    }
+}

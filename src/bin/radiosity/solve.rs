@@ -1,0 +1,122 @@
+//! `radiosity solve`.
+
+use crate::args::{source, LightGroupsArg, SceneArgs, SolverArgs, ViewArgs};
+use crate::{interrupt_flag, outln};
+use clap::Args;
+use radiosity::pipeline::{self, RunSettings, SolveJob, DEFAULT_CHECKPOINT_EVERY};
+use radiosity::progress::Progress;
+use radiosity::solve::StopReason;
+use std::path::PathBuf;
+
+#[derive(Args)]
+pub struct SolveArgs {
+    /// OBJ file (with its MTL beside it); the built-in Cornell box if left out.
+    scene: Option<PathBuf>,
+    #[command(flatten)]
+    scene_args: SceneArgs,
+    #[command(flatten)]
+    solve_args: SolverArgs,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    /// A reference patch table (a patches.csv of the same scene and patch size, e.g. from
+    /// `radiosity reference`): the trace then records the error against it.
+    #[arg(long, value_name = "PATCHES.csv")]
+    reference: Option<PathBuf>,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Print nothing but errors.
+    #[arg(long, short)]
+    quiet: bool,
+    /// Print the JSON summary on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Also save the solution to this file (read by `render`, `export` and `relight`).
+    #[arg(long, value_name = "FILE.rad")]
+    save: Option<PathBuf>,
+    /// Keep one channel per light (saved with --save), so `radiosity relight` can re-weight
+    /// the lights without solving again.
+    #[arg(long)]
+    per_light: bool,
+    /// Write the solver's state to this file (atomically) every --checkpoint-every seconds and
+    /// on Ctrl-C; `--resume FILE` continues from it.
+    #[arg(long, value_name = "FILE")]
+    checkpoint: Option<PathBuf>,
+    /// Seconds between checkpoints.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = DEFAULT_CHECKPOINT_EVERY,
+        requires = "checkpoint",
+        allow_negative_numbers = true
+    )]
+    checkpoint_every: f64,
+    /// Continue a solve from a checkpoint of the same scene and settings.
+    #[arg(long, value_name = "FILE")]
+    resume: Option<PathBuf>,
+    /// With --per-light: one channel per emitting material, or per connected emitting surface.
+    #[arg(long, value_enum, default_value_t = LightGroupsArg::Material, requires = "per_light")]
+    light_groups: LightGroupsArg,
+}
+
+pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
+    let job = SolveJob {
+        source: source(a.scene),
+        settings: RunSettings {
+            load: a.scene_args.load(),
+            mesh: a.scene_args.mesh(),
+            solve: a.solve_args.settings(),
+            intersector: a.solve_args.intersector(),
+            per_light: a.per_light.then_some(a.light_groups.into()),
+        },
+        view: a.view.settings(),
+        out: a.out.clone(),
+        reference: a.reference,
+        save: a.save.clone(),
+        checkpoint: a.checkpoint.clone(),
+        checkpoint_every: a.checkpoint_every,
+        resume: a.resume,
+        interrupt: Some(interrupt_flag()),
+    };
+    let quiet = a.quiet || a.json;
+    let progress = Progress::for_terminal(quiet);
+    let summary = pipeline::run_solve_with(&job, &progress, |line| {
+        if !quiet {
+            progress.println(line);
+        }
+    })?;
+    drop(progress);
+    if a.json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&summary).unwrap_or_default()
+        );
+    } else if !a.quiet {
+        outln!(
+            "{}: {} patches, {} shots, {} rays in {:.2} s; {}; energy balance residual {:.1e}; outputs in {}{}",
+            summary.scene,
+            summary.patches,
+            summary.shots,
+            summary.rays,
+            summary.seconds.total,
+            summary.error_line(),
+            summary.energy.relative_residual,
+            a.out.display(),
+            a.save
+                .as_ref()
+                .map(|p| format!(", solution saved to {}", p.display()))
+                .unwrap_or_default()
+        );
+    }
+    if summary.stop_reason == Some(StopReason::Interrupted) {
+        eprintln!(
+            "interrupted: the outputs hold the solution so far{}",
+            a.checkpoint
+                .as_ref()
+                .map(|p| format!("; continue with --resume {}", p.display()))
+                .unwrap_or_default()
+        );
+        std::process::exit(130);
+    }
+    Ok(())
+}

@@ -1,0 +1,273 @@
+//! What `radiosity solve` and `radiosity info` do (docs/design.md §1): load → mesh → build the
+//! intersector → solve → write the patch table, the trace, the image, the JSON summary and,
+//! if asked, the saved solution. The binary only fills a [`SolveJob`].
+//!
+//! - [`RunSettings`]: everything that shapes a solve's result, in one serialisable record. The
+//!   summary, the saved solution and the checkpoint key are derived from it.
+//! - [`hooks`]: what the run plugs into the solver (reference, per-light channels,
+//!   checkpoints, resume, Ctrl-C).
+//! - [`outputs`]: the files a solve writes.
+
+pub mod hooks;
+pub mod outputs;
+
+use crate::export;
+use crate::intersect::select::IntersectorKind;
+use crate::intersect::Intersector;
+use crate::mesh::{self, MeshOptions};
+use crate::model::Model;
+use crate::progress::Progress;
+use crate::render::ViewSettings;
+use crate::report::{self, Summary, Timings};
+use crate::scene::{LoadOptions, SceneSource};
+use crate::settings::Invalid;
+use crate::solve::lights::GroupBy;
+use crate::solve::{MethodKind, SolveSettings, TracePoint};
+use crate::Error;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Everything that shapes a solve's result: how the model is read and cut, how it is solved,
+/// the intersector, the per-light channels. Serialised, it is the `settings` of
+/// `summary.json` and of a saved solution, and (with the budgets left out) the key a
+/// checkpoint must match: a setting added to any of these types reaches all three.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct RunSettings {
+    pub load: LoadOptions,
+    pub mesh: MeshOptions,
+    pub solve: SolveSettings,
+    pub intersector: IntersectorKind,
+    /// Keep per-light channels, grouped so (`--per-light`, `--light-groups`).
+    pub per_light: Option<GroupBy>,
+}
+
+impl RunSettings {
+    /// Checks every setting a user can get wrong (one line naming the flag).
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.mesh.check()?;
+        self.solve.check()
+    }
+
+    /// These settings as JSON (for the summary and the saved solution).
+    pub fn to_json(&self) -> serde_json::Value {
+        serde_json::to_value(self).unwrap_or_default()
+    }
+
+    /// What a checkpoint must match to be resumed: the scene (its hash) and every setting that
+    /// shapes the result, with the patch size as the mesh resolved it. The budgets
+    /// (`--max-time`, `--max-rays`) and the gathering cap are left out: a run may be resumed
+    /// with more time.
+    pub fn checkpoint_key(&self, scene_hash: u64, patch_size: f32) -> String {
+        let shaping = RunSettings {
+            mesh: MeshOptions {
+                patch_size: Some(patch_size),
+                ..self.mesh.clone()
+            },
+            solve: SolveSettings {
+                max_time: None,
+                max_rays: None,
+                gather_cap_mib: SolveSettings::default().gather_cap_mib,
+                ..self.solve.clone()
+            },
+            ..self.clone()
+        };
+        format!(
+            "scene {scene_hash:016x}, settings {}",
+            serde_json::to_string(&shaping).unwrap_or_default()
+        )
+    }
+}
+
+/// Everything `radiosity solve` does.
+#[derive(Clone, Debug)]
+pub struct SolveJob {
+    pub source: SceneSource,
+    pub settings: RunSettings,
+    pub view: ViewSettings,
+    pub out: PathBuf,
+    /// A reference patch table (`--reference`): the trace then records the error against it.
+    pub reference: Option<PathBuf>,
+    /// Also save the solution here (`--save`), for `render`, `export` and `relight` (see
+    /// [`crate::export::solution`]).
+    pub save: Option<PathBuf>,
+    /// Checkpoint file (`--checkpoint`) and seconds between checkpoints.
+    pub checkpoint: Option<PathBuf>,
+    pub checkpoint_every: f64,
+    /// Continue from this checkpoint (`--resume`).
+    pub resume: Option<PathBuf>,
+    /// Set on Ctrl-C: stop at the next safe point.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+}
+
+/// Seconds between checkpoints by default (`--checkpoint-every`).
+pub const DEFAULT_CHECKPOINT_EVERY: f64 = 60.0;
+
+impl SolveJob {
+    /// A job with default settings on `source`, writing into `out`.
+    pub fn new(source: SceneSource, out: PathBuf) -> SolveJob {
+        SolveJob {
+            source,
+            settings: RunSettings::default(),
+            view: ViewSettings::default(),
+            out,
+            reference: None,
+            save: None,
+            checkpoint: None,
+            checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
+            resume: None,
+            interrupt: None,
+        }
+    }
+
+    /// Checks the settings a user can get wrong, before any work.
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.settings.check()?;
+        self.view.check()?;
+        if (self.checkpoint.is_some() || self.resume.is_some())
+            && self.settings.solve.method == MethodKind::Gathering
+        {
+            return Invalid::err(
+                "--checkpoint and --resume need a shooting method: gathering has no useful state before it converges",
+            );
+        }
+        if !(self.checkpoint_every > 0.0 && self.checkpoint_every.is_finite()) {
+            return Invalid::err(format!(
+                "--checkpoint-every must be a positive number of seconds, got {}",
+                self.checkpoint_every
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Runs a whole solve and writes its outputs into `job.out`. `log` receives progress lines.
+pub fn run_solve(job: &SolveJob, log: impl FnMut(&str)) -> Result<Summary, Error> {
+    run_solve_with(job, &Progress::hidden(), log)
+}
+
+/// [`run_solve`] with progress bars.
+pub fn run_solve_with(
+    job: &SolveJob,
+    progress: &Progress,
+    mut log: impl FnMut(&str),
+) -> Result<Summary, Error> {
+    job.check()?;
+    let t0 = Instant::now();
+    if let Some(save) = &job.save {
+        outputs::check_save_path(save)?;
+    }
+    // Fail on an unwritable folder before spending any time.
+    let made = export::prepare_dir(&job.out)?;
+    // On failure leave nothing behind: not the files written so far, not the new folders.
+    let mut written = Vec::new();
+    let result = solve_into(job, progress, &mut log, t0, &mut written);
+    if result.is_err() {
+        for path in &written {
+            let _ = std::fs::remove_file(path);
+        }
+        export::remove_made_dirs(&made);
+    }
+    result
+}
+
+/// The work of [`run_solve_with`] once the output folder is ready; every file it writes is
+/// recorded in `written` as soon as it exists.
+fn solve_into(
+    job: &SolveJob,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+    t0: Instant,
+    written: &mut Vec<PathBuf>,
+) -> Result<Summary, Error> {
+    let s = &job.settings;
+    let mut timings = Timings::default();
+    let model = load_model(job, progress, log, t0, &mut timings)?;
+
+    // Only the methods that cast rays need an intersector (a scene builds what it needs).
+    let t = Instant::now();
+    progress.phase("building the intersectors");
+    let isect = model.intersector_for(s.solve.method, s.intersector)?;
+    timings.build = t.elapsed().as_secs_f64();
+    if let Some((isect, chosen)) = &isect {
+        log(&format!("intersector {}: {}", isect.name(), chosen.reason));
+    }
+
+    let hooks = hooks::build(job, &model, log)?;
+    let t = Instant::now();
+    progress.start_solve(outputs::emitted_flux(&model));
+    let sol = model.solve(
+        isect.as_ref().map(|(i, _)| i),
+        &s.solve,
+        &hooks,
+        |p: &TracePoint| progress.solve_wave(p),
+    )?;
+    timings.solve = t.elapsed().as_secs_f64();
+    log(&format!("solved: {}", Summary::stats_line(&sol.stats)));
+
+    progress.phase("writing outputs");
+    let run = outputs::Run {
+        model: &model,
+        isect: isect.as_ref(),
+        sol: &sol,
+        timings,
+        t0,
+    };
+    let summary = outputs::write(job, &run, log, written)?;
+    progress.finish();
+    Ok(summary)
+}
+
+/// Loads and meshes the scene, logging its warnings and the patch size chosen.
+fn load_model(
+    job: &SolveJob,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+    t0: Instant,
+    timings: &mut Timings,
+) -> Result<Model, Error> {
+    let s = &job.settings;
+    progress.phase("loading");
+    let scene = job.source.load(&s.load)?;
+    for w in &scene.warnings {
+        log(&format!("warning: {w}"));
+    }
+    timings.load = t0.elapsed().as_secs_f64();
+    let t = Instant::now();
+    progress.phase("meshing");
+    let model = Model::from_scene(scene, &s.mesh)?;
+    timings.mesh = t.elapsed().as_secs_f64();
+    if s.mesh.patch_size.is_none() {
+        let from = if model.scene.patch_size_hint.is_some() {
+            "the scene file's own"
+        } else {
+            "derived from the scene"
+        };
+        log(&format!(
+            "patch size {} m ({from}; --patch-size to change)",
+            model.mesh.patch_size
+        ));
+    }
+    log(&format!(
+        "{}: {} polygons, {} patches",
+        model.scene.name,
+        model.scene.polygons.len(),
+        model.mesh.patches.len()
+    ));
+    Ok(model)
+}
+
+/// `radiosity info`.
+pub fn info(
+    source: &SceneSource,
+    load: &LoadOptions,
+    mesh_opts: &MeshOptions,
+) -> Result<report::SceneInfo, Error> {
+    let model = Model::load(source, load, mesh_opts)?;
+    Ok(report::scene_info(
+        &model.scene,
+        &model.mesh,
+        mesh::default_patch_size(&model.scene),
+    ))
+}

@@ -1,0 +1,260 @@
+//! The files a solve writes into its output folder: `patches.csv` (docs/design.md §5),
+//! `trace.csv`, `render.png`, `summary.json` and, with `--save`, the saved solution.
+
+use super::SolveJob;
+use crate::export::solution::{self, SavedMaterial, SolutionMeta};
+use crate::export::{patches, write_atomic};
+use crate::intersect::select::{AnyIntersector, Selection};
+use crate::intersect::Intersector;
+use crate::mesh::Mesh;
+use crate::model::Model;
+use crate::render::{self, Camera, RenderOptions};
+use crate::report::{self, EnergyReport, Summary, Timings};
+use crate::solve::{self, Solution};
+use crate::Error;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// A finished solve, ready to be written.
+pub struct Run<'a> {
+    pub model: &'a Model,
+    pub isect: Option<&'a (AnyIntersector, Selection)>,
+    pub sol: &'a Solution,
+    pub timings: Timings,
+    /// When the run started (for the total time).
+    pub t0: Instant,
+}
+
+/// Warnings about a solution a user should hear of.
+fn solution_warnings(energy: &EnergyReport) -> Vec<String> {
+    let mut w = Vec::new();
+    if energy.back_fraction > 0.05 {
+        w.push(format!(
+            "{:.1} % of the emitted light arrived on back faces and was absorbed: are some normals flipped (faces wound clockwise)? Use --two-sided for thin surfaces seen from both sides",
+            100.0 * energy.back_fraction
+        ));
+    }
+    w
+}
+
+/// Writes the outputs of `run` into `job.out` (and `job.save`), each file recorded in
+/// `written` as soon as it exists, and returns the summary it wrote.
+pub fn write(
+    job: &SolveJob,
+    run: &Run,
+    log: &mut impl FnMut(&str),
+    written: &mut Vec<PathBuf>,
+) -> Result<Summary, Error> {
+    let (model, sol) = (run.model, run.sol);
+    let (scene, m) = (&model.scene, &model.mesh);
+    let t = Instant::now();
+    let mut outputs = Vec::new();
+    let mut wrote = |path: PathBuf| {
+        outputs.push(path.display().to_string());
+        written.push(path);
+    };
+    let csv = job.out.join("patches.csv");
+    write_atomic(&csv, |w| patches::write(w, m, &scene.materials, &sol.b))?;
+    wrote(csv);
+    let trace_csv = job.out.join("trace.csv");
+    write_atomic(&trace_csv, |w| report::trace::write(w, &sol.stats.trace))?;
+    wrote(trace_csv);
+
+    let png = job.out.join("render.png");
+    let (lo, hi) = scene.bounds();
+    let img = render_solution(m, &sol.b, &job.view.camera_for(lo, hi), &job.view.image);
+    write_atomic(&png, |w| {
+        let mut buf = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut buf, image::ImageFormat::Png)
+            .map_err(std::io::Error::other)?;
+        w.write_all(buf.get_ref())
+    })?;
+    wrote(png);
+    if let Some(save) = &job.save {
+        save_solution(save, job, model, sol)?;
+        wrote(save.clone());
+    }
+
+    let energy = EnergyReport::from(&sol.stats.energy);
+    for w in solution_warnings(&energy) {
+        log(&format!("warning: {w}"));
+    }
+    let warnings: Vec<String> = scene
+        .warnings
+        .iter()
+        .cloned()
+        .chain(solution_warnings(&energy))
+        .collect();
+    let json = job.out.join("summary.json");
+    outputs.push(json.display().to_string());
+    let mut timings = run.timings.clone();
+    timings.output = t.elapsed().as_secs_f64();
+    timings.total = run.t0.elapsed().as_secs_f64();
+    let summary = summary(job, run, timings, energy, warnings, outputs);
+    write_atomic(&json, |w| {
+        serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })?;
+    written.push(json);
+    Ok(summary)
+}
+
+/// The summary of a finished solve: the scene, the settings (all of them, derived from
+/// [`super::RunSettings`]; the older top-level fields stay for the scripts that read them),
+/// the counters, the energy books, the final error and the trace.
+fn summary(
+    job: &SolveJob,
+    run: &Run,
+    timings: Timings,
+    energy: EnergyReport,
+    warnings: Vec<String>,
+    outputs: Vec<String>,
+) -> Summary {
+    let (model, sol) = (run.model, run.sol);
+    let (scene, m) = (&model.scene, &model.mesh);
+    let s = &job.settings.solve;
+    let last = sol.stats.trace.last().copied();
+    Summary {
+        version: env!("CARGO_PKG_VERSION"),
+        scene: scene.name.clone(),
+        polygons: scene.polygons.len(),
+        patches: m.patches.len(),
+        patch_size: m.patch_size,
+        axial_fraction_area: report::axial_fractions(m).1,
+        lights: report::lights(scene, m),
+        method: s.method.name(),
+        intersector: run.isect.map_or("none (no rays cast)", |(i, _)| i.name()),
+        intersector_reason: run.isect.map_or_else(
+            || "the method casts no rays".to_string(),
+            |(_, c)| c.reason.clone(),
+        ),
+        seed: s.seed,
+        threads: rayon::current_num_threads(),
+        tolerance: s.tolerance,
+        energy_per_ray: sol.stats.energy_per_ray,
+        stop_fraction: s.stop_fraction,
+        stop_reason: sol.stats.stop_reason,
+        shots: sol.stats.shots,
+        rays: sol.stats.rays,
+        waves: sol.stats.waves,
+        hemicube_shots: sol.stats.hemicube_shots,
+        hemicube_cells: sol.stats.hemicube_cells,
+        hemicube_n: s.method.uses_uniform_cube().then_some(s.hemicube_n),
+        switch: sol.stats.switch,
+        rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
+        seconds: timings,
+        energy,
+        light_channels: sol.channels.iter().map(|c| c.name.clone()).collect(),
+        error_estimate: last.map(|p| p.estimate).unwrap_or_default(),
+        error: last.and_then(|p| p.error),
+        max_unshot_over_mean: last
+            .map_or(0.0, |p| p.max_unshot_b / p.mean_b.max(f64::MIN_POSITIVE)),
+        warnings,
+        outputs,
+        settings: job.settings.to_json(),
+        trace: sol.stats.trace.clone(),
+    }
+}
+
+/// Scalar flux the lights emit (W): what the solve's progress is measured against.
+pub fn emitted_flux(model: &Model) -> f64 {
+    let materials = &model.scene.materials;
+    model
+        .mesh
+        .patches
+        .iter()
+        .map(|p| solve::scalar(&materials[p.material as usize].emission()) * p.area)
+        .sum()
+}
+
+/// Refuses a `--save` path that cannot be written, before any work is spent.
+pub fn check_save_path(path: &std::path::Path) -> Result<(), Error> {
+    if path.is_dir() {
+        return Err(Error::Invalid(format!(
+            "--save {}: is a folder; give a file name such as solution.rad",
+            path.display()
+        )));
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(dir) = parent {
+        if dir.is_file() {
+            return Err(Error::Invalid(format!(
+                "--save {}: {} is a file, not a folder",
+                path.display(),
+                dir.display()
+            )));
+        }
+        if !dir.is_dir() {
+            return Err(Error::Invalid(format!(
+                "--save {}: the folder {} does not exist",
+                path.display(),
+                dir.display()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Writes the saved solution of a finished solve (`--save`).
+fn save_solution(
+    path: &std::path::Path,
+    job: &SolveJob,
+    model: &Model,
+    sol: &solve::Solution,
+) -> Result<(), Error> {
+    let (scene, m) = (&model.scene, &model.mesh);
+    let meta = SolutionMeta {
+        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        scene: scene.name.clone(),
+        scene_hash: solution::scene_hash(scene, m.patch_size, job.settings.mesh.two_sided),
+        patch_size: m.patch_size,
+        two_sided: job.settings.mesh.two_sided,
+        method: job.settings.solve.method.name().to_string(),
+        seed: job.settings.solve.seed,
+        tolerance: job.settings.solve.tolerance,
+        energy_per_ray: sol.stats.energy_per_ray,
+        stop_fraction: job.settings.solve.stop_fraction,
+        stop_reason: sol
+            .stats
+            .stop_reason
+            .and_then(|r| serde_json::to_value(r).ok())
+            .and_then(|v| v.as_str().map(str::to_string)),
+        shots: sol.stats.shots,
+        rays: sol.stats.rays,
+        materials: scene
+            .materials
+            .iter()
+            .map(|mat| SavedMaterial {
+                name: mat.name.clone(),
+                rho: mat.rho,
+                ke: mat.ke,
+            })
+            .collect(),
+        settings: job.settings.to_json(),
+    };
+    let vertex_b = m.vertex_values(&sol.b);
+    let channels: Vec<solution::LightChannel> = sol
+        .channels
+        .iter()
+        .map(|c| solution::LightChannel {
+            name: c.name.clone(),
+            b: c.b.clone(),
+        })
+        .collect();
+    write_atomic(path, |w| {
+        solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &channels)
+    })?;
+    Ok(())
+}
+
+/// Renders patch radiosities, Gouraud-interpolated at the welded vertices, tone-mapped.
+pub fn render_solution(
+    m: &Mesh,
+    b: &[[f64; 3]],
+    cam: &Camera,
+    opts: &RenderOptions,
+) -> image::RgbImage {
+    let vertex = m.vertex_values(b);
+    let lin = render::render_linear(m, &vertex, cam, opts);
+    render::tone_map(&lin, opts.exposure).0
+}
