@@ -1,4 +1,4 @@
-//! Finds Embree 4 for linking (DESIGN.md §3), in order: `$EMBREE_DIR`, `pkg-config embree4`,
+//! Finds Embree 4 for linking (docs/design.md §3), in order: `$EMBREE_DIR`, `pkg-config embree4`,
 //! the system library folders, then the repo-local `.embree/lib` that `setup.sh` fills.
 //! `embree4-sys` asks for `-lembree4`; this script only says where it is, and sets an rpath so
 //! the binaries find it at run time without `LD_LIBRARY_PATH`.

@@ -1,6 +1,6 @@
 //! The intersectors against each other: the plane merge (Sec. 2, Fig. 4) and the hybrid against
 //! the f64 brute-force oracle and Embree, on scenes built in code, with the edge cases of
-//! DESIGN.md §4: rays along an axis, origins on a plane, shared edges and vertices, a plane of
+//! docs/design.md §4: rays along an axis, origins on a plane, shared edges and vertices, a plane of
 //! 5,000 patches, coplanar overlaps, a closed box that must not leak, skew roofs.
 mod common;
 

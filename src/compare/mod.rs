@@ -55,6 +55,7 @@ struct ReferenceSummary<'a> {
 /// `job.out`, and fails ([`Error::Failed`], after writing) if the check of its bound fails.
 pub fn run_reference(job: &ReferenceJob, mut log: impl FnMut(&str)) -> Result<Reference, Error> {
     job.solve.check()?;
+    job.mesh.check()?;
     export::prepare_dir(&job.out)?;
     let model = Model::load(&job.source, &job.load, &job.mesh)?;
     let (scene, m) = (&model.scene, &model.mesh);
@@ -206,6 +207,7 @@ fn validate(job: &CompareJob) -> Result<(), Error> {
     }
     let s = &job.solve;
     s.check()?;
+    job.mesh.check()?;
     if job.reference.is_none() {
         job.reference_solve
             .check()

@@ -1,4 +1,4 @@
-//! Binary glTF (`.glb`) with per-vertex radiosity (DESIGN.md §5): the JSON built with
+//! Binary glTF (`.glb`) with per-vertex radiosity (docs/design.md §5): the JSON built with
 //! `gltf-json`, the container written by `gltf::binary::Glb`, so a browser viewer or Blender
 //! opens it as is.
 //!

@@ -1,4 +1,4 @@
-//! Image files (DESIGN.md §5), the format chosen by the output's extension: PNG (8-bit sRGB,
+//! Image files (docs/design.md §5), the format chosen by the output's extension: PNG (8-bit sRGB,
 //! tone-mapped), Radiance `.hdr` (RGBE) and OpenEXR `.exr` (32-bit float), both holding the
 //! linear radiosity in W/m² untouched by exposure — what a lighting tool or a compositor
 //! wants. All through the `image` crate; non-finite values never reach a file (written as 0).

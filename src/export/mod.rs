@@ -1,4 +1,4 @@
-//! Files other tools read (DESIGN.md §5). Every file is written whole or not at all: into a
+//! Files other tools read (docs/design.md §5). Every file is written whole or not at all: into a
 //! temporary name beside the target, then renamed, so no partial file is left behind.
 
 pub mod glb;

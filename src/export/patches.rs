@@ -1,4 +1,4 @@
-//! The patch table (DESIGN.md §5): one CSV row per patch, stable ids in mesh order,
+//! The patch table (docs/design.md §5): one CSV row per patch, stable ids in mesh order,
 //! `id, cx, cy, cz, nx, ny, nz, area, rho_r, rho_g, rho_b, e_r, e_g, e_b, b_r, b_g, b_b`
 //! (B = radiosity in W/m²; irradiance = (B − E)/ρ).
 

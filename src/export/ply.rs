@@ -1,4 +1,4 @@
-//! PLY mesh with per-vertex radiosity (DESIGN.md §5), through `ply-rs-bw` (the maintained fork
+//! PLY mesh with per-vertex radiosity (docs/design.md §5), through `ply-rs-bw` (the maintained fork
 //! of `ply-rs`), binary little-endian.
 //!
 //! One PLY vertex per welded vertex: `x y z` (float, metres), `radiosity_r/g/b` (float, linear

@@ -3,7 +3,7 @@
 //! The sweep and the scale tests need architecture of any size, from a thousand patches to
 //! millions, that is *closed* (a shooter's rays never leave it), lit in every room, and about
 //! 85 % axis-aligned by area like the real models the paper's plane-merge intersector is meant
-//! for (Sec. 2; DESIGN.md §4: real models are 56–90 % axial).
+//! for (Sec. 2; docs/design.md §4: real models are 56–85 % axial, the paper says 90 %).
 //!
 //! **Plan.** Every floor has the same plan: a corridor along x between a south row of rooms and
 //! a north row (which also holds the stair room when there is more than one floor). Walls are

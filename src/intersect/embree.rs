@@ -1,4 +1,4 @@
-//! Closest-hit queries through Intel Embree 4 (DESIGN.md §3).
+//! Closest-hit queries through Intel Embree 4 (docs/design.md §3).
 //!
 //! The only module allowed `unsafe`: it calls `embree4-sys` directly. `embree4-rs` 0.0.16 was
 //! tried and dropped: it polls `rtcGetDeviceError` after every ray, hides the scene handle that

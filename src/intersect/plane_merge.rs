@@ -1,5 +1,5 @@
 //! The paper's intersector for axis-aligned polygons: three sorted plane lists walked by a
-//! three-way merge (Airey & Ouh-young 1989, Sec. 2, Fig. 4; DESIGN.md §4).
+//! three-way merge (Airey & Ouh-young 1989, Sec. 2, Fig. 4; docs/design.md §4).
 //!
 //! Polygons normal to x, y or z are grouped by plane and the planes sorted by coordinate, one
 //! list per axis. A ray crosses the planes of one list in coordinate order (ascending when its

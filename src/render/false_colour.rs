@@ -2,7 +2,7 @@
 //! arrives on each surface, whatever its colour, on a logarithmic colour scale with a legend.
 //!
 //! Irradiance (W/m², incident flux density) is what a surface receives: H = (B − E)/ρ per
-//! channel (DESIGN.md §5), reduced to one number by the luminance weights of the channels with
+//! channel (docs/design.md §5), reduced to one number by the luminance weights of the channels with
 //! ρ > 0. A surface with ρ = 0 in every channel reflects nothing, so its irradiance is unknown
 //! from B: it is drawn grey. The values are interpolated over the welded vertices like the
 //! radiosity in [`crate::render`], and mapped through viridis (perceptually uniform, readable

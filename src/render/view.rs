@@ -14,6 +14,16 @@ pub const DEFAULT_WIDTH: u32 = 640;
 pub const DEFAULT_HEIGHT: u32 = 480;
 pub const DEFAULT_SUPERSAMPLE: u32 = 3;
 
+/// Checks `--exposure` (images and exported meshes alike).
+pub fn check_exposure(exposure: Option<f32>) -> Result<(), Invalid> {
+    match exposure {
+        Some(e) if !(e > 0.0 && e.is_finite()) => {
+            Invalid::err(format!("--exposure must be a positive number, got {e}"))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// The camera and the picture.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ViewSettings {
@@ -32,12 +42,7 @@ impl ViewSettings {
                 r.width, r.height
             ));
         }
-        if let Some(e) = r.exposure {
-            if !(e > 0.0 && e.is_finite()) {
-                return Invalid::err(format!("--exposure must be a positive number, got {e}"));
-            }
-        }
-        Ok(())
+        check_exposure(r.exposure)
     }
 
     /// The camera for a scene with bounds (lo, hi), at this picture's aspect.

@@ -195,7 +195,7 @@ pub struct Timings {
     pub total: f64,
 }
 
-/// The energy balance with its residual (DESIGN.md: emitted = absorbed + unshot + escaped).
+/// The energy balance with its residual (docs/design.md §1: emitted = absorbed + absorbed on back faces + escaped + unshot).
 #[derive(Clone, Debug, Serialize)]
 pub struct EnergyReport {
     #[serde(flatten)]

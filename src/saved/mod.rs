@@ -170,13 +170,7 @@ pub fn run_export(job: &ExportJob) -> Result<OutputReport, Error> {
             )))
         }
     };
-    if let Some(e) = job.exposure {
-        if !(e > 0.0 && e.is_finite()) {
-            return Err(Error::Invalid(format!(
-                "--exposure must be a positive number, got {e}"
-            )));
-        }
-    }
+    crate::render::view::check_exposure(job.exposure)?;
     let sol = load_checked(&job.solution, job.check.as_ref())?;
     export_loaded(&sol, format, job)
 }

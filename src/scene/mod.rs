@@ -3,7 +3,7 @@
 //! This module owns everything that knows about OBJ/MTL (`obj.rs`, the only code that touches
 //! `tobj`) and the built-in default scene (`default.rs`). Downstream code sees only [`Scene`].
 //!
-//! Units (DESIGN.md §1): metres; MTL `Ke` is emitted *radiance* (W/sr/m²) as path tracers and
+//! Units (docs/design.md §1): metres; MTL `Ke` is emitted *radiance* (W/sr/m²) as path tracers and
 //! Radiance read it, so a Lambertian emitter's radiosity is E = π·Ke (W/m²).
 
 mod default;

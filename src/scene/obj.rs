@@ -2,7 +2,7 @@
 //!
 //! Polygons stay polygons (no triangulation: quads stay quads) and every model of the file is
 //! appended to the flat arrays of [`Scene`]. MTL `Kd` becomes the reflectance ρ, MTL `Ke` the
-//! emitted radiance (W/sr/m², DESIGN.md §1), and [`LoadOptions::emit`] overrides `Ke` by name.
+//! emitted radiance (W/sr/m², docs/design.md §1), and [`LoadOptions::emit`] overrides `Ke` by name.
 //! Faces of zero area are dropped with one warning; anything else wrong with the input is a
 //! [`SceneError`] whose message is one line naming the file — never a panic.
 //!
@@ -799,7 +799,7 @@ fn to_f64<F: Into<f64> + Copy + std::fmt::Display>(x: F) -> f64 {
     }
 }
 
-/// tobj's float as f32 (the geometry's precision, DESIGN.md §1).
+/// tobj's float as f32 (the geometry's precision, docs/design.md §1).
 fn to_f32<F: Into<f64>>(x: F) -> f32 {
     x.into() as f32
 }
