@@ -134,3 +134,22 @@ fn every_command_refuses_what_solve_refuses_in_the_same_words() {
     // Nothing was left behind by the refused runs.
     assert_eq!(std::fs::read_dir(t.path()).unwrap().count(), 0);
 }
+
+/// The flags whose default depends on the command (`reference` solves finer) show it in their
+/// help; the text must name the library's constants, not drift from them.
+#[test]
+fn help_names_the_library_defaults() {
+    use radiosity::solve::settings::*;
+    let (code, help, _) = run(&["solve", "--help"]);
+    assert_eq!(code, 0);
+    let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    for needle in [
+        format!("[default: {DEFAULT_TOLERANCE}; reference: {REFERENCE_TOLERANCE}]"),
+        format!("[default: {DEFAULT_STOP}; reference: {REFERENCE_STOP:e}]"),
+        format!("[default: {DEFAULT_SEED}]"),
+        format!("[default: {DEFAULT_HEMICUBE_N}]"),
+        format!("[default: {DEFAULT_GATHER_CAP_MIB}]"),
+    ] {
+        assert!(help.contains(&needle), "solve --help lacks {needle}");
+    }
+}
