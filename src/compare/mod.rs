@@ -17,7 +17,7 @@ use crate::intersect::Intersector;
 use crate::mesh::MeshOptions;
 use crate::pipeline::{load_reference, load_scene, SceneSource};
 use crate::scene::LoadOptions;
-use crate::solve::error::ErrorMetrics;
+use crate::solve::estimate::ErrorMetrics;
 use crate::solve::{self, MethodKind, SolveSettings, StopReason, SwitchInfo, TracePoint};
 use crate::Error;
 use reference::Reference;

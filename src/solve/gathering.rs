@@ -138,7 +138,7 @@ pub fn gauss_seidel_with(
     (b, sweeps)
 }
 
-/// Gathering's own error estimate per patch (see [`super::error`]), from three parts:
+/// Gathering's own error estimate per patch (see [`super::estimate`]), from three parts:
 /// - the form factors' error, seen through reciprocity: row i (i's hemi-cube) and column i
 ///   (A_j·F_ji/A_i, the other hemi-cubes) estimate the same exchange independently, so half
 ///   their difference, ρ_i·|Σ_j (F_ij − A_j F_ji/A_i)·B_j| / √2, measures what row i gets wrong
@@ -277,8 +277,8 @@ pub fn gather(
             Some((ch, factor)) => bs.iter().zip(ch).map(|(b, c)| b + c * factor).collect(),
             None => bs.iter().zip(&err).map(|(b, e)| b + e).collect(),
         };
-        let estimate = super::error::from_errors(&area, err.into_iter(), &b_est);
-        let error = reference.map(|r| super::error::against(&area, b, r));
+        let estimate = super::estimate::from_errors(&area, err.into_iter(), &b_est);
+        let error = reference.map(|r| super::estimate::against(&area, b, r));
         let p = TracePoint {
             time_s,
             shots: n as u64,
