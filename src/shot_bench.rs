@@ -270,6 +270,47 @@ fn model_error(model: &CostModel, cubes: &[CubeSample], rays: &[RaySample]) -> [
     ]
 }
 
+/// The cost model fitted to timed shots ([`switch::fit_cube`], [`switch::fit_rays`]); the
+/// kept constants for what there is no data for.
+pub fn fit_model(cubes: &[CubeSample], rays: &[RaySample]) -> CostModel {
+    let kept = switch::KEPT;
+    let cube_shots: Vec<(ShotWork, f64)> = cubes
+        .iter()
+        .map(|c| {
+            let w = ShotWork {
+                patches: c.patches,
+                faces: c.faces,
+                cells: c.cells,
+                tested: c.tested,
+            };
+            (w, c.seconds)
+        })
+        .collect();
+    let c = switch::fit_cube(&cube_shots).unwrap_or(kept.cube_coefficients());
+    let ray_shots: Vec<(u64, f64)> = rays.iter().map(|r| (r.rays, r.seconds)).collect();
+    CostModel {
+        patch: c[0],
+        face: c[1],
+        cell: c[2],
+        tested: c[3],
+        ray: switch::fit_rays(&ray_shots).unwrap_or(kept.ray),
+    }
+}
+
+/// The cost model fitted to the timed shots of several benchmarks together (several scenes:
+/// how the kept constants of `solve::switch` were set).
+pub fn pooled_fit(benches: &[ShotBench]) -> CostModel {
+    let cubes: Vec<CubeSample> = benches
+        .iter()
+        .flat_map(|b| b.cube_samples.iter().copied())
+        .collect();
+    let rays: Vec<RaySample> = benches
+        .iter()
+        .flat_map(|b| b.ray_samples.iter().copied())
+        .collect();
+    fit_model(&cubes, &rays)
+}
+
 /// Solves with the hybrid under one rule.
 fn hybrid(
     scene: &Scene,
@@ -377,35 +418,7 @@ pub fn bench_shots(
     let ray_samples = time_rays(&m, &isect, &from, &MODEL_RAYS, cfg.seed);
 
     let kept = switch::KEPT;
-    let cube_fit = switch::fit_cube(
-        &cube_samples
-            .iter()
-            .map(|c| {
-                let w = ShotWork {
-                    patches: c.patches,
-                    faces: c.faces,
-                    cells: c.cells,
-                    tested: c.tested,
-                };
-                (w, c.seconds)
-            })
-            .collect::<Vec<_>>(),
-    )
-    .unwrap_or(kept.cube_coefficients());
-    let ray_fit = switch::fit_rays(
-        &ray_samples
-            .iter()
-            .map(|r| (r.rays, r.seconds))
-            .collect::<Vec<_>>(),
-    )
-    .unwrap_or(kept.ray);
-    let fitted = CostModel {
-        patch: cube_fit[0],
-        face: cube_fit[1],
-        cell: cube_fit[2],
-        tested: cube_fit[3],
-        ray: ray_fit,
-    };
+    let fitted = fit_model(&cube_samples, &ray_samples);
 
     let hybrids = vec![
         hybrid(

@@ -41,20 +41,25 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-/// Kept cost constants (thread seconds, one core). Measured on the development machine class
-/// (2-core Intel Xeon VM, x86-64, release build), 2025-06, by
-/// `radiosity bench shots scenes/S.obj` for S = blocks, office, hallway, church (pooled; see
-/// the module docs). Seconds per patch transformed into a hemi-cube's frame.
-pub const PATCH_SECONDS: f64 = 4.0e-8;
+/// Kept cost constants (thread seconds on one core), all five measured together on the
+/// development machine class: a 2-core Intel Xeon VM (x86-64, `--release`, shared with another
+/// job), 2026-11-30, by
+/// `radiosity bench shots scenes/S.obj --out bench-S.json` for S = blocks, office, hallway,
+/// church and cornell-box, then fitted to the five scenes' timed shots together (their
+/// `cube_samples` and `ray_samples`; [`crate::shot_bench::pooled_fit`], the same fit `bench
+/// shots` prints per scene). Seconds per patch transformed into a hemi-cube's frame.
+pub const PATCH_SECONDS: f64 = 2.0e-8;
 /// Seconds per (patch, face) pair mapped onto a hemi-cube face and clipped to its frustum
-/// (measured as [`PATCH_SECONDS`]).
-pub const FACE_SECONDS: f64 = 1.0e-7;
-/// Seconds per hemi-cube cell cleared and read back (measured as [`PATCH_SECONDS`]).
-pub const CELL_SECONDS: f64 = 3.0e-9;
-/// Seconds per cell depth-tested by scan conversion (measured as [`PATCH_SECONDS`]).
-pub const TESTED_SECONDS: f64 = 3.0e-9;
-/// Seconds per ray of a ray shot, cast and applied (measured as [`PATCH_SECONDS`]).
-pub const RAY_SECONDS: f64 = 1.5e-7;
+/// (measured with [`PATCH_SECONDS`]).
+pub const FACE_SECONDS: f64 = 5.1e-8;
+/// Seconds per hemi-cube cell cleared and read back (measured with [`PATCH_SECONDS`]).
+pub const CELL_SECONDS: f64 = 1.6e-9;
+/// Seconds per cell depth-tested by scan conversion (measured with [`PATCH_SECONDS`]).
+pub const TESTED_SECONDS: f64 = 5.6e-9;
+/// Seconds per ray of a ray shot, cast (applying the hits adds a few percent; measured with
+/// [`PATCH_SECONDS`]). Per ray whatever the scene: the five scenes (232 to 5,267 patches)
+/// gave 1.3–1.7e-7 s with no trend worth a log₂(patches) factor.
+pub const RAY_SECONDS: f64 = 1.4e-7;
 
 /// The kept constants as a model.
 pub const KEPT: CostModel = CostModel {
