@@ -199,11 +199,12 @@ pub fn nonneg_least_squares<const K: usize>(rows: &[([f64; K], f64)]) -> Option<
         // Normal equations A c = b, A = XᵀX, b = Xᵀy.
         let mut a = vec![vec![0.0; m + 1]; m];
         for r in rows {
-            for p in 0..m {
-                for q in 0..m {
-                    a[p][q] += x(r, p) * x(r, q);
+            for (p, row) in a.iter_mut().enumerate() {
+                let xp = x(r, p);
+                for (q, v) in row[..m].iter_mut().enumerate() {
+                    *v += xp * x(r, q);
                 }
-                a[p][m] += x(r, p) * r.1;
+                row[m] += xp * r.1;
             }
         }
         let Some(c) = solve_linear(a) else {
@@ -245,10 +246,12 @@ fn solve_linear(mut a: Vec<Vec<f64>>) -> Option<Vec<f64>> {
             return None;
         }
         a.swap(col, piv);
-        for r in col + 1..m {
-            let f = a[r][col] / a[col][col];
-            for c in col..=m {
-                a[r][c] -= f * a[col][c];
+        let (top, rest) = a.split_at_mut(col + 1);
+        let pivot = &top[col];
+        for row in rest {
+            let f = row[col] / pivot[col];
+            for (v, p) in row[col..].iter_mut().zip(&pivot[col..]) {
+                *v -= f * p;
             }
         }
     }
