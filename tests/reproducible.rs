@@ -99,3 +99,34 @@ fn every_method_is_bit_identical_on_one_and_two_threads() {
         assert_same(&one, &two, method.name());
     }
 }
+
+/// `--switch-at` replays a recorded switch exactly; `--switch-by measured` still decides from
+/// measured times (and says so), and is the one way, with `max_time`, to a result that may
+/// vary from run to run.
+#[test]
+fn switch_at_replays_the_counted_switch_and_measured_is_kept() {
+    let (s, m) = load("office.obj");
+    let counted = solve_in(None, &s, &m, &SolveSettings::default());
+    let sw = counted.stats.switch.expect("switched");
+    let replay = SolveSettings {
+        switch_at: Some(sw.shot),
+        ..SolveSettings::default()
+    };
+    let replayed = solve_in(None, &s, &m, &replay);
+    assert_same(&counted, &replayed, "replayed at the counted switch");
+    let r = replayed.stats.switch.expect("switched");
+    assert!(r.forced && r.by == SwitchBy::Counted, "{r:?}");
+    // The forced switch records the counted model's predictions, the same as the rule's.
+    assert_eq!(r.hemicube_shot_seconds, sw.hemicube_shot_seconds);
+    assert_eq!(r.ray_shot_seconds, sw.ray_shot_seconds);
+
+    let measured = SolveSettings {
+        switch_by: SwitchBy::Measured,
+        ..SolveSettings::default()
+    };
+    let sol = solve_in(None, &s, &m, &measured);
+    let w = sol.stats.switch.expect("the measured rule switched too");
+    assert!(!w.forced && w.by == SwitchBy::Measured, "{w:?}");
+    assert!(w.ray_shot_seconds < w.hemicube_shot_seconds, "{w:?}");
+    assert_eq!(w.shot, sol.stats.hemicube_shots);
+}
