@@ -18,7 +18,7 @@
 //!   ([`WorkTally`]); a ray shot costs `ray·X`. Counts depend only on the scene, the seed and
 //!   the shots so far, so the switch shot, and the result, are the same on every run and
 //!   every thread count.
-//! - **Measured** ([`CubeCost`], [`probe`]): the costs are times measured during the run (a
+//! - **Measured** ([`CubeCost`], `probe`): the costs are times measured during the run (a
 //!   least-squares fit of hemi-cube shot time against cells, and a timed probe of a few
 //!   thousand rays). Adapts to the machine; the switch shot varies from run to run.
 //! - **Forced** (`--switch-at SHOT`): the switch at a given shot (an exact replay of a recorded
