@@ -72,6 +72,8 @@ pub struct CubeSample {
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct RaySample {
     pub rays: u64,
+    /// Patches in the scene (the model's per-ray cost grows with their log₂).
+    pub patches: usize,
     pub seconds: f64,
 }
 
@@ -152,7 +154,7 @@ impl ShotBench {
             ("FACE_SECONDS (per patch-face clipped)", k.face, f.face),
             ("CELL_SECONDS (per cell)", k.cell, f.cell),
             ("TESTED_SECONDS (per cell depth-tested)", k.tested, f.tested),
-            ("RAY_SECONDS (per ray)", k.ray, f.ray),
+            ("RAY_LOG2_SECONDS (per ray and log2 patches)", k.ray, f.ray),
         ] {
             s += &format!("| {name} | {a:.3e} | {b:.3e} |\n");
         }
@@ -227,12 +229,17 @@ fn time_rays(
         for &i in from {
             let mut best = RaySample {
                 rays: 0,
+                patches: m.patches.len(),
                 seconds: f64::INFINITY,
             };
             for _ in 0..ROUNDS {
                 let (seconds, rays) = time_ray_shots(m, isect, &[i], x, seed);
                 if seconds < best.seconds {
-                    best = RaySample { rays, seconds };
+                    best = RaySample {
+                        rays,
+                        seconds,
+                        ..best
+                    };
                 }
             }
             out.push(best);
@@ -262,7 +269,7 @@ fn model_error(model: &CostModel, cubes: &[CubeSample], rays: &[RaySample]) -> [
         .sum();
     let ray: f64 = rays
         .iter()
-        .map(|r| rel(model.ray_seconds(r.rays), r.seconds))
+        .map(|r| rel(model.ray_seconds(r.rays, r.patches), r.seconds))
         .sum();
     [
         cube / cubes.len().max(1) as f64,
@@ -287,7 +294,10 @@ pub fn fit_model(cubes: &[CubeSample], rays: &[RaySample]) -> CostModel {
         })
         .collect();
     let c = switch::fit_cube(&cube_shots).unwrap_or(kept.cube_coefficients());
-    let ray_shots: Vec<(u64, f64)> = rays.iter().map(|r| (r.rays, r.seconds)).collect();
+    let ray_shots: Vec<(u64, usize, f64)> = rays
+        .iter()
+        .map(|r| (r.rays, r.patches, r.seconds))
+        .collect();
     CostModel {
         patch: c[0],
         face: c[1],

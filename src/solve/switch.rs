@@ -15,7 +15,8 @@
 //!   `patch·P + face·F + cell·N_c + tested·T` (P patches transformed into the shooter's frame,
 //!   F patch-face pairs clipped, N_c cells cleared and read back, T cells depth-tested; see
 //!   [`ShotWork`]), with F per shot and T per cell taken from the hemi-cube shots so far
-//!   ([`WorkTally`]); a ray shot costs `ray·X`. Counts depend only on the scene, the seed and
+//!   ([`WorkTally`]); a ray shot costs `ray·log₂(patches)·X` (X rays, each descending a
+//!   bounding-volume hierarchy about log₂(patches) deep). Counts depend only on the scene, the seed and
 //!   the shots so far, so the switch shot, and the result, are the same on every run and
 //!   every thread count.
 //! - **Measured** ([`CubeCost`], `probe`): the costs are times measured during the run (a
@@ -43,23 +44,24 @@ use std::time::Instant;
 
 /// Kept cost constants (thread seconds on one core), all five measured together on the
 /// development machine class: a 2-core Intel Xeon VM (x86-64, `--release`, shared with another
-/// job), 2026-11-30, by
-/// `radiosity bench shots scenes/S.obj --out bench-S.json` for S = blocks, office, hallway,
-/// church and cornell-box, then fitted to the five scenes' timed shots together (their
-/// `cube_samples` and `ray_samples`; [`crate::shot_bench::pooled_fit`], the same fit `bench
-/// shots` prints per scene). Seconds per patch transformed into a hemi-cube's frame.
+/// job), 2026-11-30, by `radiosity bench shots scenes/S.obj --out bench-S.json`, twice for
+/// S = blocks, office, hallway, church and once for cornell-box, then fitted to the nine runs'
+/// timed shots together (their `cube_samples` and `ray_samples`, 6,912 hemi-cube and 1,728 ray
+/// shots; [`crate::shot_bench::pooled_fit`], the fit `bench shots` prints per scene). Seconds
+/// per patch transformed into a hemi-cube's frame.
 pub const PATCH_SECONDS: f64 = 2.0e-8;
 /// Seconds per (patch, face) pair mapped onto a hemi-cube face and clipped to its frustum
 /// (measured with [`PATCH_SECONDS`]).
-pub const FACE_SECONDS: f64 = 5.1e-8;
+pub const FACE_SECONDS: f64 = 4.7e-8;
 /// Seconds per hemi-cube cell cleared and read back (measured with [`PATCH_SECONDS`]).
-pub const CELL_SECONDS: f64 = 1.6e-9;
+pub const CELL_SECONDS: f64 = 1.4e-9;
 /// Seconds per cell depth-tested by scan conversion (measured with [`PATCH_SECONDS`]).
-pub const TESTED_SECONDS: f64 = 5.6e-9;
-/// Seconds per ray of a ray shot, cast (applying the hits adds a few percent; measured with
-/// [`PATCH_SECONDS`]). Per ray whatever the scene: the five scenes (232 to 5,267 patches)
-/// gave 1.3–1.7e-7 s with no trend worth a log₂(patches) factor.
-pub const RAY_SECONDS: f64 = 1.4e-7;
+pub const TESTED_SECONDS: f64 = 5.2e-9;
+/// Seconds per ray of a ray shot and per log₂ of the scene's patch count (the depth of the
+/// intersector's hierarchy), cast (applying the hits adds a few percent; measured with
+/// [`PATCH_SECONDS`]). Per ray alone the scenes (232 to 5,267 patches) spread 1.3× (1.1–1.7e-7
+/// s, the smallest scene cheapest); per ray and log₂(patches), a little less (1.1–1.6e-8 s).
+pub const RAY_LOG2_SECONDS: f64 = 1.3e-8;
 
 /// The kept constants as a model.
 pub const KEPT: CostModel = CostModel {
@@ -67,7 +69,7 @@ pub const KEPT: CostModel = CostModel {
     face: FACE_SECONDS,
     cell: CELL_SECONDS,
     tested: TESTED_SECONDS,
-    ray: RAY_SECONDS,
+    ray: RAY_LOG2_SECONDS,
 };
 
 /// Predicted thread seconds of a shot from its counted work.
@@ -81,7 +83,7 @@ pub struct CostModel {
     pub cell: f64,
     /// Per cell depth-tested.
     pub tested: f64,
-    /// Per ray.
+    /// Per ray and per log₂(patches).
     pub ray: f64,
 }
 
@@ -124,9 +126,14 @@ impl CostModel {
         w.terms().iter().zip(c).map(|(x, k)| x * k).sum()
     }
 
-    /// Predicted seconds of a ray shot of `rays` rays.
-    pub fn ray_seconds(&self, rays: u64) -> f64 {
-        rays as f64 * self.ray
+    /// Predicted seconds per ray in a scene of `patches` patches.
+    pub fn seconds_per_ray(&self, patches: usize) -> f64 {
+        self.ray * log2_patches(patches)
+    }
+
+    /// Predicted seconds of a ray shot of `rays` rays in a scene of `patches` patches.
+    pub fn ray_seconds(&self, rays: u64, patches: usize) -> f64 {
+        rays as f64 * self.seconds_per_ray(patches)
     }
 }
 
@@ -172,7 +179,11 @@ pub fn counted_costs(
     rays: u64,
 ) -> (CubeWork, f64, f64) {
     let work = tally.predict(patches, cells);
-    (work, model.cube_seconds(&work), model.ray_seconds(rays))
+    (
+        work,
+        model.cube_seconds(&work),
+        model.ray_seconds(rays, patches),
+    )
 }
 
 /// Least squares y ≈ Σ_k c_k·x_k with every c_k ≥ 0 (no intercept), exactly: every subset of
@@ -275,12 +286,18 @@ pub fn fit_cube(shots: &[(ShotWork, f64)]) -> Option<[f64; 4]> {
     nonneg_least_squares(&rows)
 }
 
-/// Fits the seconds per ray to timed ray shots (rays, seconds), on the relative error.
-pub fn fit_rays(shots: &[(u64, f64)]) -> Option<f64> {
+/// The scene measure a ray's cost grows with: log₂ of the patch count (at least 1).
+pub fn log2_patches(patches: usize) -> f64 {
+    (patches.max(2) as f64).log2()
+}
+
+/// Fits the seconds per ray and log₂(patches) to timed ray shots (rays, patches of the
+/// scene, seconds), on the relative error.
+pub fn fit_rays(shots: &[(u64, usize, f64)]) -> Option<f64> {
     let rows: Vec<([f64; 1], f64)> = shots
         .iter()
-        .filter(|s| s.1 > 0.0)
-        .map(|&(x, t)| ([x as f64 / t], 1.0))
+        .filter(|s| s.2 > 0.0)
+        .map(|&(x, n, t)| ([x as f64 * log2_patches(n) / t], 1.0))
         .collect();
     nonneg_least_squares(&rows).map(|c| c[0])
 }
@@ -451,7 +468,7 @@ impl SwitchPolicy {
             SwitchBy::Counted => {
                 let (work, by_cube, by_rays) =
                     counted_costs(&self.model, &self.tally, self.patches, cells, rays);
-                info.seconds_per_ray = self.model.ray;
+                info.seconds_per_ray = self.model.seconds_per_ray(self.patches);
                 info.hemicube_shot_seconds = by_cube;
                 info.ray_shot_seconds = by_rays;
                 info.hemicube_faces = work.faces;
@@ -502,7 +519,7 @@ mod tests {
             face: 1.5e-7,
             cell: 2e-9,
             tested: 5e-9,
-            ray: 1.7e-7,
+            ray: 1.3e-8,
         };
         let mut shots = Vec::new();
         for (k, cells) in [300u64, 3_000, 30_000, 300_000].into_iter().enumerate() {
@@ -515,9 +532,9 @@ mod tests {
         for (got, want) in fit.iter().zip(truth.cube_coefficients()) {
             assert!((got - want).abs() < 1e-6 * want, "{fit:?}");
         }
-        let rays: Vec<(u64, f64)> = [256u64, 1024, 4096]
+        let rays: Vec<(u64, usize, f64)> = [(256u64, 232), (1024, 2092), (4096, 5267)]
             .iter()
-            .map(|&x| (x, truth.ray_seconds(x)))
+            .map(|&(x, n)| (x, n, truth.ray_seconds(x, n)))
             .collect();
         let r = fit_rays(&rays).unwrap();
         assert!((r - truth.ray).abs() < 1e-9 * truth.ray, "{r}");
@@ -552,7 +569,7 @@ mod tests {
             cube,
             231.0 * KEPT.patch + 100.0 * KEPT.face + 5_000.0 * KEPT.cell + 10_000.0 * KEPT.tested
         );
-        assert_eq!(rays, 600.0 * KEPT.ray);
+        assert_eq!(rays, 600.0 * KEPT.ray * 232f64.log2());
         // The same counts give the same answer, bit for bit, every time.
         assert_eq!(
             (w, cube, rays),
@@ -569,7 +586,7 @@ mod tests {
             ..CubeHits::default()
         };
         p.record(5_000, &hits);
-        let cheap_rays = (cube / KEPT.ray) as u64 / 2;
+        let cheap_rays = (cube / KEPT.seconds_per_ray(232)) as u64 / 2;
         let s = p
             .consider(8, cheap_rays, 5_000, no_probe)
             .expect("rays cheaper");
