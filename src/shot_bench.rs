@@ -277,6 +277,65 @@ fn model_error(model: &CostModel, cubes: &[CubeSample], rays: &[RaySample]) -> [
     ]
 }
 
+/// Times the uniform cubes of resolutions `ns` and their non-uniform twins (the table's rows),
+/// and the small non-uniform cubes of [`MODEL_NS`], from `from`; every timed shot is also a
+/// sample of the cost model's fit.
+fn time_cubes(
+    m: &Mesh,
+    ns: &[usize],
+    from: &[usize],
+    per_ray: f64,
+) -> (Vec<CubeRow>, Vec<CubeSample>) {
+    let mut rows = Vec::new();
+    let mut cube_samples = Vec::new();
+    let mut add_samples = |cube: &Hemicube, shots: &[(ShotWork, f64)]| {
+        cube_samples.extend(shots.iter().map(|(w, t)| CubeSample {
+            n: cube.resolution(),
+            uniform: cube.is_uniform(),
+            patches: w.patches,
+            faces: w.faces,
+            cells: w.cells,
+            tested: w.tested,
+            seconds: *t,
+        }))
+    };
+    for &un in ns {
+        let uniform = Hemicube::uniform(un);
+        // The odd resolution whose largest ΔF is closest to the uniform cube's.
+        let twin = [un.saturating_sub(1).max(3) | 1, (un + 1) | 1]
+            .map(Hemicube::non_uniform)
+            .into_iter()
+            .min_by(|a, b| {
+                let d = |c: &Hemicube| (c.max_delta_ff() / uniform.max_delta_ff()).ln().abs();
+                d(a).total_cmp(&d(b))
+            })
+            .expect("two candidates");
+        let (su, sn) = (time_cube(m, &uniform, from), time_cube(m, &twin, from));
+        add_samples(&uniform, &su);
+        add_samples(&twin, &sn);
+        let (tu, tn) = (mean_seconds(&su), mean_seconds(&sn));
+        rows.push(CubeRow {
+            uniform_n: uniform.resolution(),
+            uniform_cells: uniform.cell_count(),
+            uniform_max_ff: uniform.max_delta_ff(),
+            uniform_ms: 1e3 * tu,
+            non_uniform_n: twin.resolution(),
+            non_uniform_cells: twin.cell_count(),
+            non_uniform_max_ff: twin.max_delta_ff(),
+            non_uniform_ms: 1e3 * tn,
+            cell_ratio: twin.cell_count() as f64 / uniform.cell_count() as f64,
+            time_ratio: tn / tu,
+            rays_per_uniform_shot: tu / per_ray,
+        });
+    }
+    for small in MODEL_NS {
+        let cube = Hemicube::non_uniform(small);
+        let shots = time_cube(m, &cube, from);
+        add_samples(&cube, &shots);
+    }
+    (rows, cube_samples)
+}
+
 /// The cost model fitted to timed shots ([`switch::fit_cube`], [`switch::fit_rays`]); the
 /// kept constants for what there is no data for.
 pub fn fit_model(cubes: &[CubeSample], rays: &[RaySample]) -> CostModel {
@@ -378,53 +437,7 @@ pub fn bench_shots(
     let (secs, rays) = time_ray_shots(&m, &isect, &from, 4096, cfg.seed);
     let per_ray = secs / rays.max(1) as f64;
 
-    let mut rows = Vec::new();
-    let mut cube_samples = Vec::new();
-    let mut add_samples = |cube: &Hemicube, shots: &[(ShotWork, f64)]| {
-        cube_samples.extend(shots.iter().map(|(w, t)| CubeSample {
-            n: cube.resolution(),
-            uniform: cube.is_uniform(),
-            patches: w.patches,
-            faces: w.faces,
-            cells: w.cells,
-            tested: w.tested,
-            seconds: *t,
-        }))
-    };
-    for &un in ns {
-        let uniform = Hemicube::uniform(un);
-        // The odd resolution whose largest ΔF is closest to the uniform cube's.
-        let twin = [un.saturating_sub(1).max(3) | 1, (un + 1) | 1]
-            .map(Hemicube::non_uniform)
-            .into_iter()
-            .min_by(|a, b| {
-                let d = |c: &Hemicube| (c.max_delta_ff() / uniform.max_delta_ff()).ln().abs();
-                d(a).total_cmp(&d(b))
-            })
-            .expect("two candidates");
-        let (su, sn) = (time_cube(&m, &uniform, &from), time_cube(&m, &twin, &from));
-        add_samples(&uniform, &su);
-        add_samples(&twin, &sn);
-        let (tu, tn) = (mean_seconds(&su), mean_seconds(&sn));
-        rows.push(CubeRow {
-            uniform_n: uniform.resolution(),
-            uniform_cells: uniform.cell_count(),
-            uniform_max_ff: uniform.max_delta_ff(),
-            uniform_ms: 1e3 * tu,
-            non_uniform_n: twin.resolution(),
-            non_uniform_cells: twin.cell_count(),
-            non_uniform_max_ff: twin.max_delta_ff(),
-            non_uniform_ms: 1e3 * tn,
-            cell_ratio: twin.cell_count() as f64 / uniform.cell_count() as f64,
-            time_ratio: tn / tu,
-            rays_per_uniform_shot: tu / per_ray,
-        });
-    }
-    for small in MODEL_NS {
-        let cube = Hemicube::non_uniform(small);
-        let shots = time_cube(&m, &cube, &from);
-        add_samples(&cube, &shots);
-    }
+    let (rows, cube_samples) = time_cubes(&m, ns, &from, per_ray);
     let ray_samples = time_rays(&m, &isect, &from, &MODEL_RAYS, cfg.seed);
 
     let kept = switch::KEPT;
