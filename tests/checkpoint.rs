@@ -54,14 +54,14 @@ fn recording_sink() -> (Sink, Arc<Mutex<Vec<Snapshot>>>) {
 #[test]
 fn resumed_runs_equal_uninterrupted_ones() {
     let (s, m) = office();
-    for (method, switch_at) in [
-        (MethodKind::AdaptiveRays, None),
-        (MethodKind::AdaptiveHemicube, None),
-        (MethodKind::AdaptiveHybrid, Some(12)),
+    // The hybrid with its default switch (counted work): it resumes exactly too.
+    for method in [
+        MethodKind::AdaptiveRays,
+        MethodKind::AdaptiveHemicube,
+        MethodKind::AdaptiveHybrid,
     ] {
         let base = SolveSettings {
             method,
-            switch_at,
             tolerance: 0.03,
             ..SolveSettings::default()
         };
@@ -105,6 +105,9 @@ fn resumed_runs_equal_uninterrupted_ones() {
         assert_eq!(resumed.b, plain.b, "{}", method.name());
         assert_eq!(resumed.stats.shots, plain.stats.shots);
         assert_eq!(resumed.stats.rays, plain.stats.rays);
+        let switch = |s: &Solution| s.stats.switch.map(|w| (w.shot, w.rays, w.forced));
+        assert_eq!(switch(&resumed), switch(&plain), "{}", method.name());
+        assert_eq!(switch(&with), switch(&plain), "{}", method.name());
     }
 }
 

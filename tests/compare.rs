@@ -9,7 +9,7 @@ use radiosity::compare::reference;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::{self, LoadOptions};
-use radiosity::solve::error;
+use radiosity::solve::estimate;
 use radiosity::solve::SolveSettings;
 use std::path::Path;
 
@@ -45,8 +45,8 @@ fn the_references_bound_holds_against_an_independent_reference() {
         b.check_line()
     );
     let area: Vec<f64> = m.patches.iter().map(|p| p.area).collect();
-    let diff = error::against(&area, &a.b, &b.b);
-    let expected = |f: fn(&error::ErrorMetrics) -> f64| f(&a.bound).hypot(f(&b.bound));
+    let diff = estimate::against(&area, &a.b, &b.b);
+    let expected = |f: fn(&estimate::ErrorMetrics) -> f64| f(&a.bound).hypot(f(&b.bound));
     for (name, measured, predicted) in [
         ("energy", diff.energy, expected(|e| e.energy)),
         (

@@ -8,7 +8,7 @@ use common::*;
 use glam::vec3;
 use radiosity::export::solution::{LightChannel, SavedSolution};
 use radiosity::scene::{self, LoadOptions, Scene};
-use radiosity::solve::error::against;
+use radiosity::solve::estimate::against;
 use radiosity::solve::lights::{groups, GroupBy};
 use radiosity::solve::{scalar, MethodKind, RunHooks, SolveSettings};
 use std::path::Path;

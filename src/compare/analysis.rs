@@ -119,7 +119,7 @@ pub fn cost_per_shot(trace: &[TracePoint]) -> Vec<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::error::ErrorMetrics;
+    use crate::solve::estimate::ErrorMetrics;
 
     fn point(time_s: f64, shots: u64, max_unshot_b: f64) -> TracePoint {
         TracePoint {

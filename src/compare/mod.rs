@@ -18,7 +18,7 @@ use crate::mesh::MeshOptions;
 use crate::model::Model;
 use crate::scene::LoadOptions;
 use crate::scene::SceneSource;
-use crate::solve::error::ErrorMetrics;
+use crate::solve::estimate::ErrorMetrics;
 use crate::solve::{self, MethodKind, SolveSettings, StopReason, SwitchInfo, TracePoint};
 use crate::Error;
 use reference::Reference;

@@ -7,7 +7,7 @@
 //! halves (two seeds, each half at tolerance·√2, so half the rays each and nothing spent
 //! twice); the table is their mean.
 //!
-//! **The bound** is the solver's own error estimate ([`crate::solve::error`]) of the mean:
+//! **The bound** is the solver's own error estimate ([`crate::solve::estimate`]) of the mean:
 //! each half's final estimate / √2 (sampling noise of independent halves averages down by √2;
 //! the light still owed is below the stop fraction and negligible next to it).
 //!
@@ -19,7 +19,7 @@
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
-use crate::solve::error::{self, ErrorMetrics};
+use crate::solve::estimate::{self, ErrorMetrics};
 use crate::solve::{self, MethodKind, SolveError, SolveSettings, StopReason};
 use std::time::Instant;
 
@@ -125,7 +125,7 @@ pub fn build<I: Intersector>(
     let bound = scaled(std::f64::consts::FRAC_1_SQRT_2);
     let expected = scaled(std::f64::consts::SQRT_2);
     let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
-    let diff = error::against(&area, &a.b, &b.b);
+    let diff = estimate::against(&area, &a.b, &b.b);
     let ratio = |m: f64, e: f64| {
         if e > 0.0 {
             m / e

@@ -8,7 +8,7 @@ pub mod trace;
 use crate::intersect::select;
 use crate::mesh::{Mesh, PatchClass};
 use crate::scene::Scene;
-use crate::solve::error::ErrorMetrics;
+use crate::solve::estimate::ErrorMetrics;
 use crate::solve::{scalar, EnergyBalance, SolveStats, StopReason, SwitchInfo, TracePoint};
 use serde::Serialize;
 
@@ -256,7 +256,7 @@ pub struct Summary {
     pub energy: EnergyReport,
     /// Names of the per-light channels kept (`--per-light`), in channel order.
     pub light_channels: Vec<String>,
-    /// The solver's own estimate of its final error (fractions; see `solve::error`).
+    /// The solver's own estimate of its final error (fractions; see `solve::estimate`).
     pub error_estimate: ErrorMetrics,
     /// The final error against `--reference`, when given.
     pub error: Option<ErrorMetrics>,

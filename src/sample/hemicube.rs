@@ -223,6 +223,34 @@ pub struct HemicubeBuffer {
     edges: Vec<[f32; 3]>,
 }
 
+impl HemicubeBuffer {
+    /// Sized for `cells` cells and `patches` patches, the z-buffer cleared.
+    fn reset(&mut self, cells: usize, patches: usize) {
+        self.depth.clear();
+        self.depth.resize(cells, 0.0);
+        self.id.clear();
+        self.id.resize(cells, EMPTY);
+        if self.acc.len() < patches {
+            self.acc.resize(patches, 0.0);
+        }
+    }
+}
+
+/// The work one shot did, counted: what the hybrid's cost model (Sec. 4, `solve::switch`)
+/// weighs. A function of the scene, the cube and the shot's rotation only (never of the clock
+/// or the thread count).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShotWork {
+    /// Patches transformed into the shooter's frame (every patch but the shooter).
+    pub patches: u64,
+    /// (patch, face) pairs mapped onto a face and clipped to its frustum.
+    pub faces: u64,
+    /// Cells of the cube (cleared before the shot, read back after it).
+    pub cells: u64,
+    /// Cells the scan conversion depth-tested (overdraw counted).
+    pub tested: u64,
+}
+
 impl Hemicube {
     /// The uniform N×N hemi-cube (Cohen & Greenberg 1985): top N×N, sides N×N/2 (N even; an odd
     /// N is rounded up), ΔF from the closed-form table at the cell centres, normalised so they
@@ -366,15 +394,20 @@ impl Hemicube {
 
     /// Renders every patch of `mesh` except `shooter` as seen from `eye` in `frame` (frame.n =
     /// the shooter's normal; the top face looks along n, the sides along ±t, ±b) into a z-buffer
-    /// holding the nearest patch id per cell. `jitter`: if Some, each cell's sample point is
-    /// drawn uniformly inside its cell (the paper's "jittered hemi-cube", Table 1) instead of
-    /// its centre. Patches wholly within a tiny epsilon of the base plane (the shooter's own
-    /// plane) are culled, the others clipped against it (z ≥ 0 in the frame) and against each
-    /// face's frustum before scan conversion. Back faces are drawn too (they occlude);
-    /// the caller learns they were seen from behind.
+    /// holding the nearest patch id per cell, and writes
+    /// into `out` (cleared first), sorted by patch id, (patch id, F = Σ ΔF of its cells,
+    /// seen_from_back) for every patch with F > 0. Returns the work it did, counted (the
+    /// hybrid's cost model weighs these counts, Sec. 4).
     ///
-    /// Then writes into `out` (cleared first), sorted by patch id, (patch id, F = Σ ΔF of its
-    /// cells, seen_from_back) for every patch with F > 0.
+    /// With `jitter`, every cell's sample point is drawn uniformly inside its cell (the paper's
+    /// "jittered hemi-cube", Table 1) instead of its centre. Patches wholly within a tiny
+    /// epsilon of the base plane (the shooter's own plane) are culled, the others clipped
+    /// against it (z ≥ 0 in the frame) and against each face's frustum before scan conversion.
+    /// Back faces are drawn too (they occlude); the caller learns they were seen from behind.
+    ///
+    /// The steps: size and clear the buffers; draw the jittered sample points; per patch, into
+    /// the frame ([`to_frame`]) and onto the faces ([`Hemicube::draw_patch`]); read the cells
+    /// back ([`Hemicube::read_back`]).
     #[allow(clippy::too_many_arguments)]
     pub fn shoot<R: Rng>(
         &self,
@@ -385,159 +418,129 @@ impl Hemicube {
         jitter: Option<&mut R>,
         buf: &mut HemicubeBuffer,
         out: &mut Vec<(u32, f64, bool)>,
-    ) {
+    ) -> ShotWork {
         out.clear();
-        let cells = self.cell_count();
+        buf.reset(self.cell_count(), mesh.patches.len());
+        let mut work = ShotWork {
+            cells: self.cell_count() as u64,
+            ..ShotWork::default()
+        };
+        let jittered = match jitter {
+            Some(rng) => {
+                self.draw_sample_points(rng, buf);
+                true
+            }
+            None => false,
+        };
+        // Patches in the shooter's own plane (z ≈ 0 up to f32 rounding of coordinates of this
+        // size) and edge-on ones must not be drawn.
+        let eps = 1e-5 * (1.0 + eye.abs().max_element());
+        for j in 0..mesh.patches.len() {
+            if j == shooter {
+                continue;
+            }
+            work.patches += 1;
+            if let Some(plane) = to_frame(mesh, j, eye, frame, eps, buf) {
+                self.draw_patch(j as u32, plane, jittered, buf, &mut work);
+            }
+        }
+        self.read_back(mesh, eye, buf, out);
+        work
+    }
+
+    /// Jitter: one random point per cell, drawn in cell order before any drawing.
+    fn draw_sample_points<R: Rng>(&self, rng: &mut R, buf: &mut HemicubeBuffer) {
+        buf.sample_u.clear();
+        buf.sample_v.clear();
+        for face in &self.faces {
+            for v in face.v.bounds.windows(2) {
+                for u in face.u.bounds.windows(2) {
+                    buf.sample_u.push(u[0] + rng.gen::<f32>() * (u[1] - u[0]));
+                    buf.sample_v.push(v[0] + rng.gen::<f32>() * (v[1] - v[0]));
+                }
+            }
+        }
+    }
+
+    /// Draws patch `j`, already in the frame (`buf.local`, its plane `plane`), onto every face
+    /// that can see it: mapped into the face's coordinates, clipped to its frustum, projected
+    /// and scan-converted.
+    fn draw_patch(
+        &self,
+        j: u32,
+        plane: FramePlane,
+        jittered: bool,
+        buf: &mut HemicubeBuffer,
+        work: &mut ShotWork,
+    ) {
         let HemicubeBuffer {
             depth,
             id,
             sample_u,
             sample_v,
-            acc,
-            touched,
             local,
             clip_a,
             clip_b,
             proj,
             edges,
+            ..
         } = buf;
-        depth.clear();
-        depth.resize(cells, 0.0);
-        id.clear();
-        id.resize(cells, EMPTY);
-        if acc.len() < mesh.patches.len() {
-            acc.resize(mesh.patches.len(), 0.0);
-        }
-
-        // Jitter: one random point per cell, drawn in cell order before any drawing.
-        let jittered = if let Some(rng) = jitter {
-            sample_u.clear();
-            sample_v.clear();
-            for face in &self.faces {
-                for v in face.v.bounds.windows(2) {
-                    for u in face.u.bounds.windows(2) {
-                        sample_u.push(u[0] + rng.gen::<f32>() * (u[1] - u[0]));
-                        sample_v.push(v[0] + rng.gen::<f32>() * (v[1] - v[0]));
-                    }
-                }
-            }
-            true
-        } else {
-            false
-        };
-
-        // Patches in the shooter's own plane (z ≈ 0 up to f32 rounding of coordinates of this
-        // size) and edge-on ones must not be drawn.
-        let eps = 1e-5 * (1.0 + eye.abs().max_element());
-        for (j, patch) in mesh.patches.iter().enumerate() {
-            if j == shooter {
-                continue;
-            }
-            // Into the frame, relative to the eye; cull patches wholly under the base plane.
-            local.clear();
-            let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
-            for &vi in mesh.patch_indices(j) {
-                let p = mesh.vertices[vi as usize] - eye;
-                let q = [p.dot(frame.t), p.dot(frame.b), p.dot(frame.n)];
-                zmin = zmin.min(q[2]);
-                zmax = zmax.max(q[2]);
-                local.push(q);
-            }
-            if zmax <= eps || local.len() < 3 {
-                continue;
-            }
-            // The patch's plane n·p = d (d < 0: front faces the eye); d ≈ 0 is edge-on.
-            let d = patch.normal.dot(patch.centre - eye);
-            if d.abs() <= eps {
-                continue;
-            }
-            let n_local = [
-                patch.normal.dot(frame.t),
-                patch.normal.dot(frame.b),
-                patch.normal.dot(frame.n),
-            ];
-            // Clipped at z = 0 itself, not at eps: a jittered sample may sit just above the base.
-            if zmin < 0.0 {
-                clip(local, clip_a, |q| q[2]);
-                std::mem::swap(local, clip_a);
-                if local.len() < 3 {
-                    continue;
-                }
-            }
-
-            // A face sees only points ahead of it (w > 0): a face none of the (clipped)
-            // polygon's vertices is ahead of cannot see any of it, and is skipped before the
-            // mapping and the frustum tests (most patches reach one to three faces, not five).
-            let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            for q in local.iter() {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(q[k]);
-                    hi[k] = hi[k].max(q[k]);
-                }
-            }
-            for face in &self.faces {
-                let (w_axis, w_sign) = face.axes[0];
-                let ahead = if w_sign > 0.0 {
-                    hi[w_axis] > 0.0
-                } else {
-                    lo[w_axis] < 0.0
-                };
-                if !ahead {
-                    continue;
-                }
-                // Into the face's (w, u·w, v·w) and clipped to its frustum.
-                clip_a.clear();
-                clip_a.extend(local.iter().map(|&q| face.map(q)));
-                let mut visible = true;
-                for k in 0..4 {
-                    let (mut inside, mut outside) = (false, false);
-                    for &q in clip_a.iter() {
-                        if face.plane(k, q) >= 0.0 {
-                            inside = true;
-                        } else {
-                            outside = true;
-                        }
-                    }
-                    if !inside {
-                        visible = false;
-                        break;
-                    }
-                    if outside {
-                        clip(clip_a, clip_b, |q| face.plane(k, q));
-                        std::mem::swap(clip_a, clip_b);
-                        if clip_a.len() < 3 {
-                            visible = false;
-                            break;
-                        }
-                    }
-                }
-                if !visible {
-                    continue;
-                }
-                proj.clear();
-                // w > 0 inside the frustum but at the eye itself, which only a patch whose
-                // plane holds the eye (skipped above) could reach: guard against 0/0 anyway.
-                proj.extend(clip_a.iter().map(|q| {
-                    let w = q[0].max(f32::MIN_POSITIVE);
-                    [
-                        (q[1] / w).clamp(-1.0, 1.0),
-                        (q[2] / w).clamp(face.v_lo, 1.0),
-                    ]
-                }));
-                // 1/w = n·(1, u, v)/d in the face's coordinates: affine in (u, v).
-                let nf = face.map(n_local);
-                let plane = [nf[0] / d, nf[1] / d, nf[2] / d];
-                if jittered {
-                    raster_jittered(
-                        face, proj, plane, j as u32, depth, id, sample_u, sample_v, edges,
-                    );
-                } else {
-                    raster_centres(face, proj, plane, j as u32, depth, id);
-                }
+        // A face sees only points ahead of it (w > 0): a face none of the (clipped) polygon's
+        // vertices is ahead of cannot see any of it, and is skipped before the mapping and the
+        // frustum tests (most patches reach one to three faces, not five).
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for q in local.iter() {
+            for k in 0..3 {
+                lo[k] = lo[k].min(q[k]);
+                hi[k] = hi[k].max(q[k]);
             }
         }
+        for face in &self.faces {
+            let (w_axis, w_sign) = face.axes[0];
+            let ahead = if w_sign > 0.0 {
+                hi[w_axis] > 0.0
+            } else {
+                lo[w_axis] < 0.0
+            };
+            if !ahead {
+                continue;
+            }
+            work.faces += 1;
+            if !clip_to_frustum(face, local, clip_a, clip_b) {
+                continue;
+            }
+            proj.clear();
+            // w > 0 inside the frustum but at the eye itself, which only a patch whose plane
+            // holds the eye (skipped in `to_frame`) could reach: guard against 0/0 anyway.
+            proj.extend(clip_a.iter().map(|q| {
+                let w = q[0].max(f32::MIN_POSITIVE);
+                [
+                    (q[1] / w).clamp(-1.0, 1.0),
+                    (q[2] / w).clamp(face.v_lo, 1.0),
+                ]
+            }));
+            // 1/w = n·(1, u, v)/d in the face's coordinates: affine in (u, v).
+            let nf = face.map(plane.normal);
+            let z = [nf[0] / plane.d, nf[1] / plane.d, nf[2] / plane.d];
+            work.tested += if jittered {
+                raster_jittered(face, proj, z, j, depth, id, sample_u, sample_v, edges)
+            } else {
+                raster_centres(face, proj, z, j, depth, id)
+            };
+        }
+    }
 
-        // Σ ΔF per patch, in cell order (deterministic).
+    /// Σ ΔF per patch, in cell order (deterministic), into `out` sorted by patch id.
+    fn read_back(
+        &self,
+        mesh: &Mesh,
+        eye: Vec3,
+        buf: &mut HemicubeBuffer,
+        out: &mut Vec<(u32, f64, bool)>,
+    ) {
+        let HemicubeBuffer {
+            id, acc, touched, ..
+        } = buf;
         touched.clear();
         for (c, &j) in id.iter().enumerate() {
             if j != EMPTY {
@@ -557,6 +560,94 @@ impl Hemicube {
             }
         }
     }
+}
+
+/// A patch's plane in the shooter's frame: n·p = d (d < 0: its front faces the eye).
+#[derive(Clone, Copy)]
+struct FramePlane {
+    normal: [f32; 3],
+    d: f32,
+}
+
+/// Patch `j` into the frame, relative to the eye, into `buf.local`, clipped to the base plane
+/// z ≥ 0; `None` when it is wholly under the base plane (within `eps`), edge-on, or clipped
+/// away.
+fn to_frame(
+    mesh: &Mesh,
+    j: usize,
+    eye: Vec3,
+    frame: &Frame,
+    eps: f32,
+    buf: &mut HemicubeBuffer,
+) -> Option<FramePlane> {
+    let patch = &mesh.patches[j];
+    let (local, clip_a) = (&mut buf.local, &mut buf.clip_a);
+    local.clear();
+    let (mut zmin, mut zmax) = (f32::INFINITY, f32::NEG_INFINITY);
+    for &vi in mesh.patch_indices(j) {
+        let p = mesh.vertices[vi as usize] - eye;
+        let q = [p.dot(frame.t), p.dot(frame.b), p.dot(frame.n)];
+        zmin = zmin.min(q[2]);
+        zmax = zmax.max(q[2]);
+        local.push(q);
+    }
+    if zmax <= eps || local.len() < 3 {
+        return None;
+    }
+    // d ≈ 0 is edge-on.
+    let d = patch.normal.dot(patch.centre - eye);
+    if d.abs() <= eps {
+        return None;
+    }
+    // Clipped at z = 0 itself, not at eps: a jittered sample may sit just above the base.
+    if zmin < 0.0 {
+        clip(local, clip_a, |q| q[2]);
+        std::mem::swap(local, clip_a);
+        if local.len() < 3 {
+            return None;
+        }
+    }
+    Some(FramePlane {
+        normal: [
+            patch.normal.dot(frame.t),
+            patch.normal.dot(frame.b),
+            patch.normal.dot(frame.n),
+        ],
+        d,
+    })
+}
+
+/// `local` into the face's (w, u·w, v·w), into `clip_a`, clipped to the face's frustum
+/// (`clip_b` is scratch). False when nothing of it is inside.
+fn clip_to_frustum(
+    face: &Face,
+    local: &[[f32; 3]],
+    clip_a: &mut Vec<[f32; 3]>,
+    clip_b: &mut Vec<[f32; 3]>,
+) -> bool {
+    clip_a.clear();
+    clip_a.extend(local.iter().map(|&q| face.map(q)));
+    for k in 0..4 {
+        let (mut inside, mut outside) = (false, false);
+        for &q in clip_a.iter() {
+            if face.plane(k, q) >= 0.0 {
+                inside = true;
+            } else {
+                outside = true;
+            }
+        }
+        if !inside {
+            return false;
+        }
+        if outside {
+            clip(clip_a, clip_b, |q| face.plane(k, q));
+            std::mem::swap(clip_a, clip_b);
+            if clip_a.len() < 3 {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// Sutherland–Hodgman: the part of convex polygon `src` where `dist ≥ 0`, into `dst`.
@@ -620,6 +711,7 @@ fn v_range(poly: &[[f32; 2]]) -> (f32, f32) {
 
 /// Sec. 2's scan conversion: per cell row at its centre height, the span's ends (widened by
 /// [`EDGE_TOL`]) mapped through the look-up table onto the cells whose centres it covers.
+/// Returns the cells it depth-tested.
 fn raster_centres(
     face: &Face,
     poly: &[[f32; 2]],
@@ -627,10 +719,11 @@ fn raster_centres(
     j: u32,
     depth: &mut [f32],
     id: &mut [u32],
-) {
+) -> u64 {
     let (vmin, vmax) = v_range(poly);
     let rows = face.v.first_centre(vmin - EDGE_TOL)..face.v.first_centre(vmax + EDGE_TOL);
     let nu = face.u.len();
+    let mut tested = 0;
     for r in rows {
         let v = face.v.centres[r];
         let Some((u0, u1)) = span_at(poly, v, (vmin, vmax)) else {
@@ -638,7 +731,9 @@ fn raster_centres(
         };
         let row = face.first + r * nu;
         let z_row = plane[0] + plane[2] * v;
-        for i in face.u.first_centre(u0 - EDGE_TOL)..face.u.first_centre(u1 + EDGE_TOL) {
+        let span = face.u.first_centre(u0 - EDGE_TOL)..face.u.first_centre(u1 + EDGE_TOL);
+        tested += span.len() as u64;
+        for i in span {
             let z = z_row + plane[1] * face.u.centres[i];
             let c = row + i;
             if z > depth[c] {
@@ -647,10 +742,11 @@ fn raster_centres(
             }
         }
     }
+    tested
 }
 
 /// Jittered: per row band, the cells the polygon's extent over the band can touch, each tested
-/// at its own sample point against the polygon's edge functions.
+/// at its own sample point against the polygon's edge functions. Returns the cells it tested.
 #[allow(clippy::too_many_arguments)]
 fn raster_jittered(
     face: &Face,
@@ -662,7 +758,7 @@ fn raster_jittered(
     sample_u: &[f32],
     sample_v: &[f32],
     edges: &mut Vec<[f32; 3]>,
-) {
+) -> u64 {
     let m = poly.len();
     let area2: f32 = (0..m)
         .map(|k| {
@@ -671,7 +767,7 @@ fn raster_jittered(
         })
         .sum();
     if area2 == 0.0 {
-        return;
+        return 0;
     }
     // Inside: a·u + b·v + c ≥ −EDGE_TOL for every edge, (a, b) the edge's unit inward normal (signs
     // follow the projected winding); a clipped-away zero-length edge tests nothing.
@@ -689,6 +785,7 @@ fn raster_jittered(
     }));
     let (vmin, vmax) = v_range(poly);
     let nu = face.u.len();
+    let mut tested = 0;
     for r in face.v.cells_meeting(vmin - EDGE_TOL, vmax + EDGE_TOL) {
         let lo = face.v.bounds[r].clamp(vmin, vmax);
         let hi = face.v.bounds[r + 1].clamp(vmin, vmax);
@@ -709,7 +806,9 @@ fn raster_jittered(
             continue;
         }
         let row = face.first + r * nu;
-        for i in face.u.cells_meeting(u0 - EDGE_TOL, u1 + EDGE_TOL) {
+        let span = face.u.cells_meeting(u0 - EDGE_TOL, u1 + EDGE_TOL);
+        tested += span.len() as u64;
+        for i in span {
             let c = row + i;
             let (u, v) = (sample_u[c], sample_v[c]);
             if edges
@@ -724,6 +823,7 @@ fn raster_jittered(
             }
         }
     }
+    tested
 }
 
 /// Sec. 2: the positive cell boundaries along the top face's diagonal, x_0 = 1/N, …, 1, and

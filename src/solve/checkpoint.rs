@@ -4,9 +4,9 @@
 //! the wave in flight is applied there, so the books hold everything and nothing is cast. Safe
 //! points come at the same waves whether or not anyone checkpoints, so a run resumed from one
 //! continues exactly as the uninterrupted run did: same shooters in the same order, same random
-//! numbers (they depend on the seed and the shot number only), same result. `adaptive-hybrid`
-//! decides its switch from measured times, which no run repeats; with `--switch-at` it resumes
-//! exactly too.
+//! numbers (they depend on the seed and the shot number only), same result. This holds for
+//! `adaptive-hybrid` too: its switch is decided from counted work (the work counted so far is
+//! in the header); only with `--switch-by measured` does it depend on times no run repeats.
 //!
 //! The file: an 8-byte magic, a format version (u32), the payload's length (u64) and its CRC-32
 //! (u32), then the payload: a JSON header (settings key, counters, trace) behind its length,
@@ -63,8 +63,13 @@ pub struct Header {
     pub switch: Option<SwitchInfo>,
     /// Hemi-cube shots still to come (the hemi-cube methods, or the hybrid before switching).
     pub cubes_active: bool,
+    /// `--switch-by measured`: the sums of the fit of hemi-cube shot times, and the measured
+    /// seconds per ray (see [`super::switch`]).
     pub cube_cost: [f64; 5],
     pub ray_cost: Option<f64>,
+    /// `adaptive-hybrid`: the hemi-cube shots' counted work so far (see [`super::switch`]).
+    #[serde(default)]
+    pub cube_work: super::switch::WorkTally,
     pub trace: Vec<TracePoint>,
     /// Lengths of the arrays that follow.
     pub cube_len: usize,

@@ -1,6 +1,6 @@
-//! Shooting with hemi-cubes (Cohen et al. 1988 with the hemi-cube of Cohen & Greenberg 1985),
-//! and the paper's adaptive variant (Sec. 2), plus the cost model that tells the hybrid when
-//! rays become cheaper (Sec. 4).
+//! Hemi-cube shots: shooting with hemi-cubes (Cohen et al. 1988 with the hemi-cube of Cohen &
+//! Greenberg 1985), jittered (Sec. 3, Table 1), and the paper's adaptive non-uniform variant
+//! (Sec. 2). When the hybrid stops using them is [`super::switch`]'s business.
 //!
 //! A shot puts a hemi-cube at the shooter's centre, turned by a random angle about its normal
 //! (Sec. 3), z-buffers every other patch onto it and reads F_ij as the sum of the delta form
@@ -11,8 +11,8 @@
 //!   energy it carries: the non-adaptive baseline.
 //! - **Adaptive** (`adaptive-hemicube`): Sec. 2, "the number of samples is determined as a
 //!   proportion of the unshot radiosity": N = sqrt(C/3 · unshot), rounded to the closest odd
-//!   integer, with C here the samples per unit of unshot flux, 1/(energy per sample). A uniform
-//!   N×N cube would have 3N² = ΔΦ/C_e cells (C_e the energy per ray of the ray shooter); the
+//!   integer, with C here the samples per unit of unshot flux, 1/(energy per ray). A uniform
+//!   N×N cube would have 3N² = ΔΦ/C_e cells (C_e the energy per ray of the ray shots); the
 //!   non-uniform cube has about π/12 of them, none with a larger ΔF than the uniform one's
 //!   largest, so every cell carries at most the energy the uniform cube's central cell would.
 //!
@@ -20,9 +20,10 @@
 //! in parallel with one buffer per thread, applied in shot order), so the result does not
 //! depend on the thread count.
 
-use super::state::{rng_for, State};
+use super::books::State;
+use super::rng_for;
 use crate::mesh::Mesh;
-use crate::sample::hemicube::{Hemicube, HemicubeBuffer};
+use crate::sample::hemicube::{Hemicube, HemicubeBuffer, ShotWork};
 use crate::sample::Frame;
 use rand::Rng;
 use rayon::prelude::*;
@@ -60,10 +61,12 @@ pub struct CubeShot {
     pub cube: Arc<Hemicube>,
 }
 
-/// What one shot found: (patch, F, seen from behind) sorted by patch, and the thread time it
-/// took (s).
+/// What one shot found: (patch, F, seen from behind) sorted by patch; the work it did,
+/// counted; and the thread time it took (s; read only by `--switch-by measured`).
+#[derive(Default)]
 pub struct CubeHits {
     pub ff: Vec<(u32, f64, bool)>,
+    pub work: ShotWork,
     pub seconds: f64,
 }
 
@@ -75,26 +78,26 @@ thread_local! {
 /// Builds and caches the cubes, and renders waves of shots.
 pub struct CubeShooter {
     pub kind: CubeKind,
-    /// Energy per sample (scalar W): the ray shooter's C.
-    energy_per_sample: f64,
+    /// Energy per ray C (scalar W): the ray shots' C, which sets the adaptive resolution.
+    energy_per_ray: f64,
     cache: HashMap<usize, Arc<Hemicube>>,
     cached_cells: usize,
 }
 
 impl CubeShooter {
-    pub fn new(kind: CubeKind, energy_per_sample: f64) -> CubeShooter {
+    pub fn new(kind: CubeKind, energy_per_ray: f64) -> CubeShooter {
         CubeShooter {
             kind,
-            energy_per_sample,
+            energy_per_ray,
             cache: HashMap::new(),
             cached_cells: 0,
         }
     }
 
-    /// Sec. 2: N = sqrt(C/3 · unshot), C = 1/(energy per sample), rounded to the closest odd
+    /// Sec. 2: N = sqrt(C/3 · unshot), C = 1/(energy per ray), rounded to the closest odd
     /// integer; clamped to [3, MAX_ADAPTIVE_N].
     pub fn adaptive_resolution(&self, flux: f64) -> usize {
-        let n = (flux / self.energy_per_sample / 3.0).max(0.0).sqrt();
+        let n = (flux / self.energy_per_ray / 3.0).max(0.0).sqrt();
         // Closest odd integer: 2·round((n − 1)/2) + 1.
         let odd = 2.0 * ((n - 1.0) / 2.0).round() + 1.0;
         (odd.max(3.0) as usize).min(MAX_ADAPTIVE_N)
@@ -128,10 +131,7 @@ impl CubeShooter {
     pub fn cast(&self, mesh: &Mesh, seed: u64, wave: &[CubeShot], hits: &mut Vec<CubeHits>) {
         let jitter = matches!(self.kind, CubeKind::Uniform { jitter: true, .. });
         if hits.len() < wave.len() {
-            hits.resize_with(wave.len(), || CubeHits {
-                ff: Vec::new(),
-                seconds: 0.0,
-            });
+            hits.resize_with(wave.len(), CubeHits::default);
         }
         wave.par_iter()
             .zip(hits.par_iter_mut())
@@ -142,7 +142,7 @@ impl CubeShooter {
                 let mut rng = rng_for(seed, shot.index, u64::MAX);
                 let frame = Frame::new(p.normal, rng.gen::<f32>() * std::f32::consts::TAU);
                 let mut jitter_rng = rng_for(seed, shot.index, 0);
-                BUFFER.with_borrow_mut(|buf| {
+                out.work = BUFFER.with_borrow_mut(|buf| {
                     shot.cube.shoot(
                         mesh,
                         shot.patch,
@@ -191,67 +191,6 @@ pub(super) fn apply(st: &mut State, shot: &CubeShot, hits: &CubeHits) {
     st.cells += shot.cube.cell_count() as u64;
 }
 
-/// Sec. 4: the measured cost of a hemi-cube shot, fitted as t = a + b·cells by least squares
-/// over the shots so far (a: transforming and clipping every patch, b: scan conversion and
-/// reading the cells back). Thread time, so it compares with the rays' thread time per ray.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct CubeCost {
-    n: f64,
-    sx: f64,
-    sy: f64,
-    sxx: f64,
-    sxy: f64,
-}
-
-impl CubeCost {
-    /// The running sums (for checkpoints).
-    pub fn sums(&self) -> [f64; 5] {
-        [self.n, self.sx, self.sy, self.sxx, self.sxy]
-    }
-
-    pub fn from_sums(s: [f64; 5]) -> CubeCost {
-        CubeCost {
-            n: s[0],
-            sx: s[1],
-            sy: s[2],
-            sxx: s[3],
-            sxy: s[4],
-        }
-    }
-
-    pub fn add(&mut self, cells: usize, seconds: f64) {
-        let x = cells as f64;
-        self.n += 1.0;
-        self.sx += x;
-        self.sy += seconds;
-        self.sxx += x * x;
-        self.sxy += x * seconds;
-    }
-
-    pub fn samples(&self) -> usize {
-        self.n as usize
-    }
-
-    /// Predicted seconds of a shot with `cells` cells (the mean when all shots had the same
-    /// size, or the fit would give a negative slope or intercept).
-    pub fn predict(&self, cells: usize) -> f64 {
-        if self.n == 0.0 {
-            return 0.0;
-        }
-        let mean_y = self.sy / self.n;
-        let var = self.sxx - self.sx * self.sx / self.n;
-        if var <= 1e-9 * self.sxx.max(1.0) {
-            return mean_y;
-        }
-        let b = (self.sxy - self.sx * self.sy / self.n) / var;
-        let a = mean_y - b * self.sx / self.n;
-        if b < 0.0 || a < 0.0 {
-            return mean_y;
-        }
-        a + b * cells as f64
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -266,19 +205,5 @@ mod tests {
         assert_eq!(s.adaptive_resolution(3.0 * 10.0 * 10.0), 11);
         assert_eq!(s.adaptive_resolution(0.5), 3);
         assert_eq!(s.adaptive_resolution(1e30), MAX_ADAPTIVE_N);
-    }
-
-    #[test]
-    fn cost_fit_recovers_a_line() {
-        let mut c = CubeCost::default();
-        for cells in [100, 400, 1600, 6400] {
-            c.add(cells, 1e-4 + 2e-8 * cells as f64);
-        }
-        let p = c.predict(10_000);
-        assert!((p - (1e-4 + 2e-4)).abs() < 1e-9, "{p}");
-        let mut same = CubeCost::default();
-        same.add(500, 1.0);
-        same.add(500, 3.0);
-        assert_eq!(same.predict(10), 2.0);
     }
 }

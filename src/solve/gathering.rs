@@ -138,7 +138,7 @@ pub fn gauss_seidel_with(
     (b, sweeps)
 }
 
-/// Gathering's own error estimate per patch (see [`super::error`]), from three parts:
+/// Gathering's own error estimate per patch (see [`super::estimate`]), from three parts:
 /// - the form factors' error, seen through reciprocity: row i (i's hemi-cube) and column i
 ///   (A_j·F_ji/A_i, the other hemi-cubes) estimate the same exchange independently, so half
 ///   their difference, ρ_i·|Σ_j (F_ij − A_j F_ji/A_i)·B_j| / √2, measures what row i gets wrong
@@ -277,8 +277,8 @@ pub fn gather(
             Some((ch, factor)) => bs.iter().zip(ch).map(|(b, c)| b + c * factor).collect(),
             None => bs.iter().zip(&err).map(|(b, e)| b + e).collect(),
         };
-        let estimate = super::error::from_errors(&area, err.into_iter(), &b_est);
-        let error = reference.map(|r| super::error::against(&area, b, r));
+        let estimate = super::estimate::from_errors(&area, err.into_iter(), &b_est);
+        let error = reference.map(|r| super::estimate::against(&area, b, r));
         let p = TracePoint {
             time_s,
             shots: n as u64,
@@ -325,7 +325,42 @@ pub fn gather(
         point(*t, bk, Some((&conv, 1.0)));
     }
 
-    // Where the light went, from B: i sends B_i·A_i·F_ij to j.
+    let energy = energy_balance(&ff, &b, &e, &rho, &area);
+    let seconds = start.elapsed().as_secs_f64();
+    let stats = SolveStats {
+        shots: n as u64,
+        rays: 0,
+        hemicube_shots: n as u64,
+        hemicube_cells: (n as u64) * Hemicube::uniform(n_cube).cell_count() as u64,
+        waves: sweeps as u64,
+        seconds,
+        energy_per_ray: 0.0,
+        stop_reason: Some(StopReason::Converged),
+        energy,
+        trace,
+        ..SolveStats::default()
+    };
+    // Per-light channels: the same matrix, each light's emission alone (B is linear in E).
+    let channels = light_groups
+        .map(|g| light_channels(&ff, g, &e, &rho, &area, stop_fraction))
+        .unwrap_or_default();
+    Solution {
+        b,
+        unshot: vec![[0.0; 3]; n],
+        stats,
+        channels,
+    }
+}
+
+/// Where the light went, from the answer B: i sends B_i·A_i·F_ij to j.
+fn energy_balance(
+    ff: &FormFactors,
+    b: &[[f64; 3]],
+    e: &[[f64; 3]],
+    rho: &[[f64; 3]],
+    area: &[f64],
+) -> EnergyBalance {
+    let n = ff.n;
     let mut energy = EnergyBalance::default();
     let mut arrived = vec![[0.0f64; 3]; n];
     for i in 0..n {
@@ -348,46 +383,33 @@ pub fn gather(
             energy.absorbed[c] += (1.0 - rho[j][c]) * arrived[j][c];
         }
     }
-    let seconds = start.elapsed().as_secs_f64();
-    let stats = SolveStats {
-        shots: n as u64,
-        rays: 0,
-        hemicube_shots: n as u64,
-        hemicube_cells: (n as u64) * Hemicube::uniform(n_cube).cell_count() as u64,
-        waves: sweeps as u64,
-        seconds,
-        energy_per_ray: 0.0,
-        stop_reason: Some(StopReason::Converged),
-        energy,
-        trace,
-        ..SolveStats::default()
-    };
-    // Per-light channels: the same matrix, each light's emission alone (B is linear in E).
-    let channels = light_groups
-        .map(|g| {
-            g.names
+    energy
+}
+
+/// Per-light channels: the same matrix, each light group's emission alone (B is linear in E).
+fn light_channels(
+    ff: &FormFactors,
+    g: &super::lights::LightGroups,
+    e: &[[f64; 3]],
+    rho: &[[f64; 3]],
+    area: &[f64],
+    stop_fraction: f64,
+) -> Vec<super::Channel> {
+    g.names
+        .iter()
+        .enumerate()
+        .map(|(c, name)| {
+            let e_c: Vec<[f64; 3]> = e
                 .iter()
-                .enumerate()
-                .map(|(c, name)| {
-                    let e_c: Vec<[f64; 3]> = e
-                        .iter()
-                        .zip(&g.of_patch)
-                        .map(|(e, &grp)| if grp as usize == c { *e } else { [0.0; 3] })
-                        .collect();
-                    super::Channel {
-                        name: name.clone(),
-                        b: gauss_seidel(&ff, &e_c, &rho, &area, stop_fraction, 100_000).0,
-                    }
-                })
-                .collect()
+                .zip(&g.of_patch)
+                .map(|(e, &grp)| if grp as usize == c { *e } else { [0.0; 3] })
+                .collect();
+            super::Channel {
+                name: name.clone(),
+                b: gauss_seidel(ff, &e_c, rho, area, stop_fraction, 100_000).0,
+            }
         })
-        .unwrap_or_default();
-    Solution {
-        b,
-        unshot: vec![[0.0; 3]; n],
-        stats,
-        channels,
-    }
+        .collect()
 }
 
 #[cfg(test)]

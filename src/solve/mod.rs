@@ -1,26 +1,50 @@
-//! Solvers: progressive refinement by shooting (Cohen et al. 1988) with the adaptive
-//! polar hemisphere sampler of Airey & Ouh-young (1989, Sec. 2).
+//! Solvers: progressive refinement by shooting (Cohen et al. 1988) with the two adaptive
+//! samplers of Airey & Ouh-young (1989) and their hybrid, and the traditional gathering
+//! algorithm they are compared against.
 //!
 //! Notation follows the papers: patch `i` shoots, patch `j` receives; `b` is radiosity
 //! (W/m²), `e` emitted radiosity, `rho` reflectance; energies are fluxes Φ = B·A in f64 per RGB
 //! channel. A shot moves the shooter's unshot flux ΔΦ_i into the scene: each ray carries
 //! ΔΦ_i / X and the patch it hits first gains ρ_j·ΔΦ_i/X (so ΔB_j += ρ_j·ΔΦ_i·F_ij/A_j with
 //! F_ij estimated by the fraction of rays).
+//!
+//! Where the paper's parts are:
+//! - [`driver`]: the shooting loop (picks the next shooters, hands them to ray or hemi-cube
+//!   shots, asks the stopping rule and the switch policy);
+//! - [`ray_shots`]: Sec. 2, the adaptive polar ray shot (X = ΔΦ/C rays, C the energy per ray);
+//! - [`cube_shots`]: the uniform, jittered (Table 1) and adaptive non-uniform (Sec. 2)
+//!   hemi-cube shots;
+//! - [`switch`]: Sec. 4, when `adaptive-hybrid` goes from hemi-cubes (curve C) to rays
+//!   (curve D), and the cost model it decides by;
+//! - [`stopping`]: Sec. 3, the stop rule (0.06 % of the mean radiosity) and the budgets;
+//! - [`estimate`]: Sec. 3's error metrics, and the solver's own estimate of its error;
+//! - [`books`]: the energy books every shooting method keeps;
+//! - [`gathering`]: the traditional algorithm (full form-factor matrix, Gauss–Seidel);
+//! - [`checkpoint`], [`lights`] (per-light channels), [`settings`].
+//!
+//! **Reproducible.** The same scene, mesh, settings and seed give bit-identical results on any
+//! run and any thread count, for every method: random numbers come from (seed, shot, chunk),
+//! waves have a fixed composition and are applied in a fixed order, and the hybrid's switch is
+//! decided from counted work ([`SwitchBy::Counted`]). Only `max_time` (a clock budget) and
+//! `switch_by: measured` make a result depend on the clock.
 
+pub mod books;
 pub mod checkpoint;
 pub mod cube_shots;
-pub mod error;
+pub mod driver;
+pub mod estimate;
 pub mod gathering;
 pub mod lights;
-pub mod progressive;
+pub mod ray_shots;
 pub mod settings;
-mod state;
+pub mod stopping;
+pub mod switch;
 
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
 
-pub use settings::{MethodKind, RunHooks, SolveSettings};
+pub use settings::{MethodKind, RunHooks, SolveSettings, SwitchBy};
 
 /// Why the solve stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -50,10 +74,10 @@ pub struct TracePoint {
     pub mean_b: f64,
     /// Total unshot flux (scalar), W.
     pub unshot_flux: f64,
-    /// The solver's own estimate of its error (see [`error`]).
-    pub estimate: error::ErrorMetrics,
+    /// The solver's own estimate of its error (see [`estimate`]).
+    pub estimate: estimate::ErrorMetrics,
     /// The error against the reference, when the solve was given one.
-    pub error: Option<error::ErrorMetrics>,
+    pub error: Option<estimate::ErrorMetrics>,
 }
 
 /// Where the emitted energy went (W per RGB channel). emitted = absorbed + absorbed_back +
@@ -112,23 +136,37 @@ pub struct SolveStats {
     pub switch: Option<SwitchInfo>,
 }
 
-/// The hemi-cube → rays switch of `adaptive-hybrid` (Sec. 4), with the costs it compared.
+/// The hemi-cube → rays switch of `adaptive-hybrid` (Sec. 4), with the costs it compared (see
+/// [`switch`]). Seconds are thread seconds: measured ones with `switch_by: measured`, the cost
+/// model's predictions from counted work with `switch_by: counted` (the default).
 #[derive(Clone, Copy, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct SwitchInfo {
     /// The first shot cast by rays.
     pub shot: u64,
     /// Rays that shot needed (X = ΔΦ/C).
     pub rays: u64,
-    /// Measured wall time one ray costs (s), all threads.
+    /// Time one ray costs (s), all threads: measured, or the cost model's.
     pub seconds_per_ray: f64,
-    /// Measured wall time of a hemi-cube shot at that point (s).
+    /// Time of a hemi-cube shot at that point (s): predicted by the fit of measured shot times,
+    /// or by the cost model from counted work.
     pub hemicube_shot_seconds: f64,
-    /// The cost of the shot by rays: rays × seconds_per_ray (s).
+    /// The cost of the shot by rays (s): rays × seconds_per_ray (plus the model's per-shot
+    /// cost when counted).
     pub ray_shot_seconds: f64,
     /// Cells of the hemi-cube that shot would have used.
     pub hemicube_cells: u64,
-    /// Whether `--switch-at` set the shot rather than the measured costs.
+    /// Whether `--switch-at` set the shot rather than the costs.
     pub forced: bool,
+    /// Which costs were compared: counted work (`counted`) or measured times (`measured`).
+    #[serde(default)]
+    pub by: SwitchBy,
+    /// Counted: the work the hemi-cube shot was predicted to do (faces clipped and cells
+    /// depth-tested; from the hemi-cube shots so far), besides `hemicube_cells` and one
+    /// transform per patch.
+    #[serde(default)]
+    pub hemicube_faces: f64,
+    #[serde(default)]
+    pub hemicube_tested: f64,
 }
 
 /// The result: radiosity per patch, and the energy not yet shot.
@@ -162,7 +200,7 @@ pub fn scalar(v: &[f64; 3]) -> f64 {
 pub enum SolveError {
     #[error("the scene has no light: no material emits (give one a Ke in the MTL file, or use --emit MATERIAL=R,G,B)")]
     NoEmitter,
-    #[error("the scene has {0} patches; at most {max} are supported", max = progressive::BACK - 1)]
+    #[error("the scene has {0} patches; at most {max} are supported", max = ray_shots::BACK - 1)]
     TooManyPatches(usize),
     #[error(transparent)]
     GatherTooLarge(#[from] gathering::TooLarge),
@@ -222,6 +260,21 @@ pub fn run<I: Intersector>(
             }
             Ok(gathering::gather(mesh, materials, cfg, hooks, on_trace))
         }
-        _ => progressive::shoot(mesh, materials, isect, cfg, hooks, on_trace),
+        _ => driver::shoot(mesh, materials, isect, cfg, hooks, on_trace),
     }
+}
+
+/// splitmix64: decorrelates (seed, shot, chunk) into independent RNG seeds.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// The random numbers of one shot's chunk of samples: a function of (seed, shot, chunk) only,
+/// so results do not depend on which thread draws them.
+pub(crate) fn rng_for(seed: u64, shot: u64, chunk: u64) -> rand_pcg::Pcg64Mcg {
+    use rand::SeedableRng;
+    rand_pcg::Pcg64Mcg::seed_from_u64(mix(mix(mix(seed) ^ shot) ^ chunk))
 }

@@ -86,6 +86,32 @@ impl MethodKind {
     }
 }
 
+/// How `adaptive-hybrid` decides when rays become cheaper than hemi-cubes (Sec. 4;
+/// `--switch-by`). See [`super::switch`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum SwitchBy {
+    /// From counted work (patches transformed, faces clipped, cells cleared and tested; rays
+    /// cast) weighed by cost constants the code keeps ([`super::switch::KEPT`], measured by
+    /// `radiosity bench shots`): the same switch shot on every run and thread count. The
+    /// default.
+    #[default]
+    Counted,
+    /// From times measured during the solve (a least-squares fit of hemi-cube shot times
+    /// against cells, and a timed probe of a few thousand rays): adapts to the machine, but
+    /// the switch shot, and so the result, varies from run to run.
+    Measured,
+}
+
+impl SwitchBy {
+    pub fn name(&self) -> &'static str {
+        match self {
+            SwitchBy::Counted => "counted",
+            SwitchBy::Measured => "measured",
+        }
+    }
+}
+
 /// What the solver does, independent of the scene: the settings of `solve`, `compare`,
 /// `reference`, `sweep` and the benchmarks alike.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -93,10 +119,10 @@ impl MethodKind {
 pub struct SolveSettings {
     pub method: MethodKind,
     /// Seed of every random choice; the result depends on it and nothing else (not the number
-    /// of threads, not the clock).
+    /// of threads, not the clock; but see `max_time` and `switch_by: measured`).
     pub seed: u64,
     /// Requested relative sampling error of a typical patch's radiosity; sets the energy per
-    /// ray (see [`super::progressive::energy_per_ray`]).
+    /// ray (see [`super::ray_shots::energy_per_ray`]).
     pub tolerance: f64,
     /// Overrides the energy per ray C (W, scalar flux) derived from `tolerance`.
     pub energy_per_ray: Option<f64>,
@@ -114,6 +140,10 @@ pub struct SolveSettings {
     pub gather_cap_mib: u64,
     /// `adaptive-hybrid`: switch to rays at this shot instead of when the cost model says so.
     pub switch_at: Option<u64>,
+    /// `adaptive-hybrid`: decide the switch from counted work and kept cost constants (the
+    /// default; reproducible) or from times measured during the run (not reproducible).
+    /// `switch_at` overrides both.
+    pub switch_by: SwitchBy,
 }
 
 impl Default for SolveSettings {
@@ -130,6 +160,7 @@ impl Default for SolveSettings {
             hemicube_n: DEFAULT_HEMICUBE_N,
             gather_cap_mib: DEFAULT_GATHER_CAP_MIB,
             switch_at: None,
+            switch_by: SwitchBy::Counted,
         }
     }
 }
@@ -240,6 +271,23 @@ mod tests {
         };
         let text = serde_json::to_string(&s).unwrap();
         assert_eq!(serde_json::from_str::<SolveSettings>(&text).unwrap(), s);
+        let measured = SolveSettings {
+            switch_by: SwitchBy::Measured,
+            ..SolveSettings::default()
+        };
+        let text = serde_json::to_string(&measured).unwrap();
+        assert!(text.contains(r#""switch_by":"measured""#), "{text}");
+        assert_eq!(
+            serde_json::from_str::<SolveSettings>(&text).unwrap(),
+            measured
+        );
+        // Settings written before the field existed read as the default.
+        assert_eq!(
+            serde_json::from_str::<SolveSettings>("{}")
+                .unwrap()
+                .switch_by,
+            SwitchBy::Counted
+        );
     }
 
     #[test]

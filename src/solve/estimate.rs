@@ -1,4 +1,6 @@
-//! Error against a reference, and the solver's own estimate of its error when there is none.
+//! The solver's error estimates (Sec. 3): the error against a reference, and the solver's
+//! own estimate of its error when there is none. (Not the crate's Rust errors: those are
+//! `crate::error`.)
 //!
 //! **The paper's metrics** (Sec. 3, on scalar radiosity, the mean of RGB):
 //! - average energy error = Σ_i |Φ_i − Φ_i^ref| / Σ_i Φ_i^ref, with Φ = B·A;
@@ -74,7 +76,7 @@ pub struct Estimator<'a> {
     pub emission: &'a [f64],
     /// Mean reflectance ρ_j.
     pub rho: &'a [f64],
-    /// Energy per ray C.
+    /// Energy per ray C (scalar W; Sec. 2).
     pub energy_per_ray: f64,
     /// Area-weighted mean reflectance: the share of shot light kept before anything is known.
     pub rho_mean: f64,

@@ -1,12 +1,12 @@
 //! The shooting solvers' books: per-patch unshot and gathered flux, the priority queues that
-//! pick the next shooter, and the energy accounts. Shared by the ray shooter
-//! ([`super::progressive`]) and the hemi-cube shooter ([`super::cube_shots`]), so every method
-//! keeps the same books and stops by the same criterion (Sec. 3).
+//! pick the next shooter, and the energy accounts. Shared by the ray shots
+//! ([`super::ray_shots`]) and the hemi-cube shots ([`super::cube_shots`]), so every method
+//! keeps the same books and stops by the same criterion (Sec. 3, [`super::stopping`]).
 //!
 //! Picking a shooter costs O(log patches): lazily updated binary heaps, one by unshot flux (who
 //! shoots next) and one by unshot radiosity (the stopping criterion), never a scan.
 
-use super::error::{self, Books, Estimator};
+use super::estimate::{self, Books, Estimator};
 use super::{scalar, EnergyBalance, SolveStats, TracePoint};
 use crate::mesh::Mesh;
 use crate::scene::Material;
@@ -117,7 +117,7 @@ pub(super) struct State {
     pub rho_mean: f64,
     rho_max: f64,
     /// Of each patch's kept flux, what hemi-cube shots left (scalar), and its sampling
-    /// variance Σ ρ·e_cell·kept (see [`super::error`]). Empty until a hemi-cube shot lands.
+    /// variance Σ ρ·e_cell·kept (see [`super::estimate`]). Empty until a hemi-cube shot lands.
     cube_gathered: Vec<f64>,
     cube_var: Vec<f64>,
     pub channels: Option<Channels>,
@@ -521,7 +521,7 @@ impl State {
                 .zip(est.area)
                 .map(|((g, e), a)| [e + g / a; 3])
                 .collect();
-            error::against(est.area, &b, r)
+            estimate::against(est.area, &b, r)
         });
         let p = TracePoint {
             time_s: elapsed,
@@ -537,19 +537,4 @@ impl State {
         stats.trace.push(p);
         on_trace(&p);
     }
-}
-
-/// splitmix64: decorrelates (seed, shot, chunk) into independent RNG seeds.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
-}
-
-/// The random numbers of one shot's chunk of samples: a function of (seed, shot, chunk) only,
-/// so results do not depend on which thread draws them.
-pub(super) fn rng_for(seed: u64, shot: u64, chunk: u64) -> rand_pcg::Pcg64Mcg {
-    use rand::SeedableRng;
-    rand_pcg::Pcg64Mcg::seed_from_u64(mix(mix(mix(seed) ^ shot) ^ chunk))
 }

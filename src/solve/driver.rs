@@ -1,0 +1,523 @@
+//! The shooting driver: progressive refinement by shooting (Cohen et al. 1988) as Airey &
+//! Ouh-young (1989) run it, for every shooting method.
+//!
+//! Each step takes the patches with the most unshot flux ΔΦ_i off a priority queue and shoots
+//! them: by rays ([`super::ray_shots`], Sec. 2), by hemi-cubes ([`super::cube_shots`]), or, for
+//! `adaptive-hybrid`, by hemi-cubes until the switch policy ([`super::switch`], Sec. 4) says
+//! rays are cheaper and by rays from then on. Before each step the stop rule
+//! ([`super::stopping`], Sec. 3) is asked whether to go on. The books ([`super::books`]) hold
+//! every patch's unshot and kept flux.
+//!
+//! **Waves.** Late in a solve shots are tiny (a few rays each), too small to feed two cores. So
+//! shooters are taken from the top of the queue in *waves* (about [`WAVE_RAYS`] rays, or
+//! [`CUBE_WAVE`] hemi-cubes), cast in parallel against the books at the start of the wave, and
+//! their hits applied in a fixed order. Picking a shooter costs O(log patches) (a lazily
+//! updated binary heap), never O(patches). Ray waves are pipelined: while one thread applies
+//! wave k's hits, the others cast wave k + 1, which was taken off the heap before wave k's
+//! deposits reached it; its shooters are then at most one wave out of date, the books stay
+//! exact and the order stays fixed.
+//!
+//! **Reproducible.** Every random number comes from (seed, shot, chunk); a wave's composition
+//! depends on the books and the settings only; the hybrid's switch on counted work (by
+//! default). So the result is the same on any run and any number of threads. The clock is
+//! read for three things that never change the books or the shot order: trace points (taken
+//! at geometric steps of elapsed time and of shots, they only read the books), checkpoints
+//! (written at safe points that come every [`SYNC_WAVES`] waves whether or not one is due),
+//! and `max_time` (a clock budget, the one setting whose result depends on the clock), plus
+//! `--switch-by measured`.
+
+use super::books::State;
+use super::checkpoint::{Header, Snapshot, SYNC_WAVES};
+use super::cube_shots::{self, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WAVE};
+use super::estimate::Estimator;
+use super::ray_shots::{
+    apply_rays, energy_per_ray, grid_for, tasks_of, RayCaster, RayShot, Task, BACK, WAVE_RAYS,
+};
+use super::stopping::{self, Progress};
+use super::switch::{self, CostModel, SwitchPolicy};
+use super::{
+    scalar, Channel, MethodKind, RunHooks, Solution, SolveError, SolveSettings, SolveStats,
+    StopReason, TracePoint,
+};
+use crate::intersect::Intersector;
+use crate::mesh::Mesh;
+use crate::scene::Material;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Shoots until Sec. 3's criterion or a budget stops it, by the method `cfg.method` names
+/// (any but gathering). `isect` is needed by the methods that cast rays (`adaptive-rays`,
+/// `adaptive-hybrid`); the hemi-cube methods never cast a ray. `on_trace` is called with each
+/// new trace point (for progress display).
+pub fn shoot<I: Intersector>(
+    mesh: &Mesh,
+    materials: &[Material],
+    isect: Option<&I>,
+    cfg: &SolveSettings,
+    hooks: &RunHooks,
+    on_trace: impl FnMut(&TracePoint),
+) -> Result<Solution, SolveError> {
+    shoot_with(mesh, materials, isect, cfg, hooks, switch::KEPT, on_trace)
+}
+
+/// [`shoot`], the hybrid's counted switch weighing work by `model` instead of the kept
+/// constants (`radiosity bench shots` compares the two).
+pub fn shoot_with<I: Intersector>(
+    mesh: &Mesh,
+    materials: &[Material],
+    isect: Option<&I>,
+    cfg: &SolveSettings,
+    hooks: &RunHooks,
+    model: CostModel,
+    mut on_trace: impl FnMut(&TracePoint),
+) -> Result<Solution, SolveError> {
+    let start = Instant::now();
+    let mut d = Driver::new(mesh, materials, isect, cfg, hooks, model)?;
+    if let Some(snap) = &hooks.resume {
+        d.resume(snap)?;
+    }
+    let reason = d.run(start, &mut on_trace)?;
+    Ok(d.finish(reason, start))
+}
+
+/// Per-patch scalars of the solver's error estimate.
+struct PatchScalars {
+    area: Vec<f64>,
+    emission: Vec<f64>,
+    rho: Vec<f64>,
+    rho_mean: f64,
+}
+
+impl PatchScalars {
+    fn new(mesh: &Mesh, materials: &[Material]) -> PatchScalars {
+        let material = |p: &crate::mesh::Patch| &materials[p.material as usize];
+        let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
+        let rho: Vec<f64> = mesh
+            .patches
+            .iter()
+            .map(|p| scalar(&material(p).rho))
+            .collect();
+        PatchScalars {
+            emission: mesh
+                .patches
+                .iter()
+                .map(|p| scalar(&material(p).emission()))
+                .collect(),
+            rho_mean: rho.iter().zip(&area).map(|(r, a)| r * a).sum::<f64>() / mesh.total_area(),
+            area,
+            rho,
+        }
+    }
+
+    fn estimator(&self, energy_per_ray: f64) -> Estimator<'_> {
+        Estimator {
+            area: &self.area,
+            emission: &self.emission,
+            rho: &self.rho,
+            energy_per_ray,
+            rho_mean: self.rho_mean,
+        }
+    }
+}
+
+/// A ray wave cast but not yet applied.
+struct Pending {
+    wave: Vec<RayShot>,
+    tasks: Vec<Task>,
+    hits: Vec<Vec<u32>>,
+}
+
+/// One shooting solve in progress.
+struct Driver<'a, I> {
+    mesh: &'a Mesh,
+    materials: &'a [Material],
+    cfg: &'a SolveSettings,
+    hooks: &'a RunHooks,
+    st: State,
+    /// C: the energy every ray carries (scalar W; Sec. 2).
+    energy_per_ray: f64,
+    scalars: PatchScalars,
+    /// Casts the rays (the methods that cast rays).
+    caster: Option<RayCaster<'a, I>>,
+    /// Hemi-cube shots still to come (the hemi-cube methods, or the hybrid before it switches).
+    cubes: Option<CubeShooter>,
+    cube_hits: Vec<CubeHits>,
+    switch: SwitchPolicy,
+    stats: SolveStats,
+    pending: Option<Pending>,
+    /// Seconds the run resumed from had already taken.
+    time_offset: f64,
+    next_trace: f64,
+    next_trace_shots: u64,
+    next_checkpoint: f64,
+    last_sync: Option<u64>,
+    interrupt_now: bool,
+}
+
+impl<'a, I: Intersector> Driver<'a, I> {
+    /// Checks what a user can get wrong, and sets up the books, C and the shooters.
+    fn new(
+        mesh: &'a Mesh,
+        materials: &'a [Material],
+        isect: Option<&'a I>,
+        cfg: &'a SolveSettings,
+        hooks: &'a RunHooks,
+        model: CostModel,
+    ) -> Result<Self, SolveError> {
+        let n = mesh.patches.len();
+        if n >= BACK as usize {
+            return Err(SolveError::TooManyPatches(n));
+        }
+        let method = cfg.method;
+        if method.casts_rays() && isect.is_none() {
+            return Err(SolveError::NoIntersector(method.name()));
+        }
+        let mut st = State::new(mesh, materials, cfg.stop_fraction);
+        if scalar(&st.energy.emitted) <= 0.0 {
+            return Err(SolveError::NoEmitter);
+        }
+        if let Some(g) = &hooks.light_groups {
+            st.start_channels(&g.of_patch, g.len());
+        }
+        if let Some(r) = &hooks.reference {
+            if r.len() != n {
+                return Err(SolveError::ReferenceMismatch {
+                    reference: r.len(),
+                    patches: n,
+                });
+            }
+        }
+        let rho: Vec<[f64; 3]> = mesh
+            .patches
+            .iter()
+            .map(|p| materials[p.material as usize].rho)
+            .collect();
+        let c = cfg.energy_per_ray.filter(|c| *c > 0.0).unwrap_or_else(|| {
+            energy_per_ray(mesh, &rho, scalar(&st.energy.emitted), cfg.tolerance)
+        });
+        let cubes = match method {
+            MethodKind::Hemicube | MethodKind::HemicubeJittered => Some(CubeKind::Uniform {
+                n: cfg.hemicube_n,
+                jitter: method == MethodKind::HemicubeJittered,
+            }),
+            MethodKind::AdaptiveHemicube | MethodKind::AdaptiveHybrid => Some(CubeKind::Adaptive),
+            MethodKind::AdaptiveRays | MethodKind::Gathering => None,
+        };
+        Ok(Driver {
+            mesh,
+            materials,
+            cfg,
+            hooks,
+            st,
+            energy_per_ray: c,
+            scalars: PatchScalars::new(mesh, materials),
+            caster: isect.map(|isect| RayCaster::new(mesh, isect, cfg.seed, cfg.jitter)),
+            cubes: cubes.map(|kind| CubeShooter::new(kind, c)),
+            cube_hits: Vec::new(),
+            switch: SwitchPolicy::new(cfg, model, n),
+            stats: SolveStats {
+                energy_per_ray: c,
+                ..SolveStats::default()
+            },
+            pending: None,
+            time_offset: 0.0,
+            next_trace: 0.0,
+            next_trace_shots: 0,
+            next_checkpoint: 0.0,
+            last_sync: None,
+            interrupt_now: false,
+        })
+    }
+
+    /// Carries on from a checkpoint: the books, the counters, the switch policy's state and
+    /// the trace so far (see [`super::checkpoint`]).
+    fn resume(&mut self, snap: &Snapshot) -> Result<(), SolveError> {
+        let h = &snap.header;
+        let c = self.energy_per_ray;
+        if (h.energy_per_ray - c).abs() > 1e-12 * c {
+            return Err(SolveError::Checkpoint(format!(
+                "the checkpoint's energy per ray is {} W, this run's {c} W: resume with the same --tolerance or --energy-per-ray",
+                h.energy_per_ray
+            )));
+        }
+        self.st.restore(snap).map_err(SolveError::Checkpoint)?;
+        let stats = &mut self.stats;
+        stats.shots = h.shots;
+        stats.waves = h.waves;
+        stats.hemicube_shots = h.hemicube_shots;
+        stats.hemicube_cells = h.hemicube_cells;
+        stats.switch = h.switch;
+        stats.trace = h.trace.clone();
+        if !h.cubes_active {
+            self.cubes = None;
+        }
+        self.switch.restore(h);
+        self.time_offset = h.elapsed;
+        self.next_trace = h.elapsed;
+        self.next_trace_shots = h.shots;
+        self.next_checkpoint = h.elapsed;
+        Ok(())
+    }
+
+    /// The loop: a safe point when one is due, the stop rule, a trace point when one is due,
+    /// then a wave of hemi-cube or ray shots.
+    fn run(
+        &mut self,
+        start: Instant,
+        on_trace: &mut impl FnMut(&TracePoint),
+    ) -> Result<StopReason, SolveError> {
+        loop {
+            let elapsed = self.time_offset + start.elapsed().as_secs_f64();
+            self.safe_point(elapsed)?;
+            let (progress, flying) = self.progress(elapsed);
+            let cfg = self.cfg;
+            let st = &mut self.st;
+            if let Some(r) = stopping::verdict(cfg, &progress, || st.has_unshot()) {
+                // Deposits still in flight may change the verdict: apply them and look again.
+                if self.land_pending() {
+                    continue;
+                }
+                self.record(elapsed, progress.max_unshot_b, 0.0, on_trace);
+                return Ok(r);
+            }
+            // Trace points at geometric steps of time and of shots (even spacing on the log-log
+            // plots of error against time). They read the books, never change them.
+            if elapsed >= self.next_trace || self.stats.shots >= self.next_trace_shots {
+                self.record(elapsed, progress.max_unshot_b, flying, on_trace);
+                self.next_trace = (elapsed * 1.25).max(elapsed + 0.002);
+                self.next_trace_shots = (self.stats.shots as f64 * 1.25) as u64 + 8;
+            }
+            if self.cubes.is_some() {
+                self.cube_wave();
+            } else {
+                self.ray_wave(progress.samples);
+            }
+        }
+    }
+
+    /// Applies the ray wave in flight, if any; whether there was one.
+    fn land_pending(&mut self) -> bool {
+        match self.pending.take() {
+            Some(p) => {
+                apply_rays(&mut self.st, &p.wave, &p.tasks, &p.hits);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// A safe point every SYNC_WAVES waves, whether or not anyone checkpoints (so runs with
+    /// and without checkpoints, and resumed runs, shoot the same): the wave in flight lands,
+    /// then a checkpoint is written if one is due or Ctrl-C was pressed.
+    fn safe_point(&mut self, elapsed: f64) -> Result<(), SolveError> {
+        if !self.stats.waves.is_multiple_of(SYNC_WAVES) || self.last_sync == Some(self.stats.waves)
+        {
+            return Ok(());
+        }
+        self.last_sync = Some(self.stats.waves);
+        self.land_pending();
+        let interrupted = self
+            .hooks
+            .interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
+        if let Some(sink) = &self.hooks.checkpoint {
+            if interrupted || elapsed >= self.next_checkpoint {
+                let stats = &self.stats;
+                let mut header = Header {
+                    key: sink.key.clone(),
+                    elapsed,
+                    shots: stats.shots,
+                    waves: stats.waves,
+                    hemicube_shots: stats.hemicube_shots,
+                    hemicube_cells: stats.hemicube_cells,
+                    energy_per_ray: self.energy_per_ray,
+                    switch: stats.switch,
+                    cubes_active: self.cubes.is_some(),
+                    trace: stats.trace.clone(),
+                    ..Header::default()
+                };
+                self.switch.save(&mut header);
+                (sink.write)(&self.st.snapshot(header)).map_err(SolveError::Checkpoint)?;
+                self.next_checkpoint = elapsed + sink.every.as_secs_f64();
+            }
+        }
+        // Only here, at a safe point, so a resumed run repeats the same shots.
+        self.interrupt_now = interrupted;
+        Ok(())
+    }
+
+    /// What the stop rule looks at, and the flux of the wave in flight (scalar W).
+    fn progress(&mut self, elapsed: f64) -> (Progress, f64) {
+        let (in_flight, flying) = self.pending.as_ref().map_or((0, 0.0), |p| {
+            (
+                p.hits.iter().map(Vec::len).sum::<usize>() as u64,
+                p.wave.iter().map(|s| scalar(&s.phi)).sum::<f64>(),
+            )
+        });
+        let progress = Progress {
+            interrupted: self.interrupt_now,
+            max_unshot_b: self.st.max_unshot_b(),
+            amplification: self.st.amplification(flying),
+            mean_b: self.st.mean_b(),
+            elapsed,
+            samples: self.st.rays + self.st.cells + in_flight,
+        };
+        (progress, flying)
+    }
+
+    /// Adds a trace point (the books are only read).
+    fn record(
+        &mut self,
+        elapsed: f64,
+        max_b: f64,
+        flying: f64,
+        on_trace: &mut impl FnMut(&TracePoint),
+    ) {
+        let est = self.scalars.estimator(self.energy_per_ray);
+        let reference = self.hooks.reference.as_deref().map(Vec::as_slice);
+        self.st.record(
+            &mut self.stats,
+            elapsed,
+            max_b,
+            &est,
+            reference,
+            flying,
+            on_trace,
+        );
+    }
+
+    /// A wave of hemi-cube shots. For the hybrid, each shot first asks the switch policy
+    /// whether it is cheaper by rays (Sec. 4); from the first that is, the hemi-cubes stop.
+    fn cube_wave(&mut self) {
+        let Some(shooter) = self.cubes.as_mut() else {
+            return;
+        };
+        let mut wave: Vec<CubeShot> = Vec::new();
+        let mut switch = None;
+        while wave.len() < CUBE_WAVE {
+            let Some((i, flux)) = self.st.peek_shooter() else {
+                break;
+            };
+            let cube = shooter.cube_for(flux);
+            if self.cfg.method == MethodKind::AdaptiveHybrid {
+                let rays = grid_for(flux, self.energy_per_ray).len() as u64;
+                let caster = self.caster.as_ref().expect("checked in Driver::new");
+                let probe = || switch::probe(caster, i);
+                switch = self
+                    .switch
+                    .consider(self.stats.shots, rays, cube.cell_count(), probe);
+                if switch.is_some() {
+                    break;
+                }
+            }
+            let (patch, phi) = self.st.take_shooter().expect("peeked");
+            let ch = self.st.take_channels(patch);
+            wave.push(CubeShot {
+                patch,
+                index: self.stats.shots,
+                phi,
+                ch,
+                cube,
+            });
+            self.stats.shots += 1;
+        }
+        if !wave.is_empty() {
+            shooter.cast(self.mesh, self.cfg.seed, &wave, &mut self.cube_hits);
+            for (shot, h) in wave.iter().zip(&self.cube_hits) {
+                self.switch.record(shot.cube.cell_count(), h);
+                cube_shots::apply(&mut self.st, shot, h);
+            }
+            self.st.finish_batch();
+            self.stats.hemicube_shots += wave.len() as u64;
+            self.stats.waves += 1;
+        }
+        if switch.is_some() {
+            self.stats.switch = switch;
+            self.cubes = None;
+        }
+    }
+
+    /// Takes a wave of ray shots off the top of the heap (Sec. 2: X = ΔΦ_i / C rays each), at
+    /// most what the `max_rays` budget leaves after `samples`.
+    fn take_ray_wave(&mut self, samples: u64) -> Vec<RayShot> {
+        let mut wave = Vec::new();
+        let mut wave_rays = 0usize;
+        let ray_cap = self
+            .cfg
+            .max_rays
+            .map_or(usize::MAX, |r| r.saturating_sub(samples) as usize);
+        while wave_rays < WAVE_RAYS.min(ray_cap.max(1)) {
+            let Some((i, phi)) = self.st.take_shooter() else {
+                break;
+            };
+            let ch = self.st.take_channels(i);
+            let grid = grid_for(scalar(&phi), self.energy_per_ray);
+            wave_rays += grid.len();
+            wave.push(RayShot {
+                patch: i,
+                index: self.stats.shots,
+                phi,
+                ch,
+                grid,
+            });
+            self.stats.shots += 1;
+        }
+        wave
+    }
+
+    /// A wave of ray shots, cast in parallel while the previous wave is applied.
+    fn ray_wave(&mut self, samples: u64) {
+        let wave = self.take_ray_wave(samples);
+        if wave.is_empty() {
+            // Nothing to shoot until the wave in flight lands.
+            self.land_pending();
+            return;
+        }
+        let caster = self.caster.as_ref().expect("checked in Driver::new");
+        let tasks = tasks_of(&wave);
+        let cast = || -> Vec<Vec<u32>> {
+            tasks
+                .par_iter()
+                .map(|t| caster.cast(&wave[t.shot], t.chunk, t.first, t.count))
+                .collect()
+        };
+        let st = &mut self.st;
+        let hits = match self.pending.take() {
+            Some(p) => rayon::join(|| apply_rays(st, &p.wave, &p.tasks, &p.hits), cast).1,
+            None => cast(),
+        };
+        self.pending = Some(Pending { wave, tasks, hits });
+        self.stats.waves += 1;
+    }
+
+    /// Closes the books and hands back the solution.
+    fn finish(mut self, reason: StopReason, start: Instant) -> Solution {
+        let st = &mut self.st;
+        st.close_books();
+        let mut stats = self.stats;
+        stats.rays = st.rays;
+        stats.hemicube_cells = st.cells;
+        stats.energy = st.energy;
+        stats.stop_reason = Some(reason);
+        stats.seconds = self.time_offset + start.elapsed().as_secs_f64();
+        let channels = match &self.hooks.light_groups {
+            Some(g) => st
+                .channel_radiosity(self.mesh, self.materials, &g.of_patch)
+                .into_iter()
+                .zip(&g.names)
+                .map(|(b, name)| Channel {
+                    name: name.clone(),
+                    b,
+                })
+                .collect(),
+            None => Vec::new(),
+        };
+        Solution {
+            b: st.radiosity(self.mesh, self.materials),
+            unshot: st.patches.iter().map(|p| p.unshot).collect(),
+            stats,
+            channels,
+        }
+    }
+}

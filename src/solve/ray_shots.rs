@@ -1,0 +1,255 @@
+//! Sec. 2 of Airey & Ouh-young (1989): the adaptive ray shot.
+//!
+//! A shot from patch `i` casts X = ΔΦ_i / C rays, C the *energy per ray* ([`energy_per_ray`]):
+//! samples in proportion to the unshot energy, so every ray carries the same energy C. The rays
+//! go through the equal-area polar cells of [`PolarGrid`] (the unit circle split into X pieces
+//! of form factor 1/X each, twice as many θ divisions as radial ones, radii at √k), turned by a
+//! random angle about the normal (Sec. 3: the random rotation of Cohen et al.), from points
+//! spread uniformly over the patch ([`PatchPoints`]). The patch `j` a ray hits first receives
+//! ρ_j·ΔΦ_i/X; the rest is absorbed ([`apply_rays`]).
+//!
+//! Rays are cast in chunks of [`CHUNK`], the unit of parallel work; every chunk's random
+//! numbers come from (seed, shot, chunk), so what a ray hits never depends on which thread cast
+//! it. [`super::driver`] groups shots into waves of about [`WAVE_RAYS`] rays.
+
+use super::books::State;
+use super::{rng_for, scalar};
+use crate::intersect::{Intersector, Ray};
+use crate::mesh::Mesh;
+use crate::sample::{polar::PolarGrid, Frame};
+use glam::Vec3;
+use rand::Rng;
+use std::time::Instant;
+
+/// Rays per wave of shots (see [`super::driver`]). Fixed, so results do not depend on threads.
+pub const WAVE_RAYS: usize = 32_768;
+/// Rays per parallel task.
+pub const CHUNK: usize = 1024;
+/// Hit codes: a patch id, a patch id with this bit for a back-face hit, or [`ESCAPED`].
+pub(super) const BACK: u32 = 1 << 31;
+const ESCAPED: u32 = u32::MAX;
+
+/// The energy per ray C (scalar W) for a requested relative error τ of a typical patch: the
+/// paper's "constant of proportionality" between unshot energy and samples (Sec. 2), picked
+/// from the accuracy asked for.
+///
+/// A patch hit N times has a relative sampling error of about 1/√N, so a typical patch should
+/// be hit 1/τ² times. All shots together move about Φ_emit / (1 − ρ̄) (every bounce keeps ρ̄),
+/// spread over n patches, so C = Φ_emit·τ² / (n·(1 − ρ̄)) — about n/τ² rays in all, whatever ρ̄.
+pub fn energy_per_ray(mesh: &Mesh, rho: &[[f64; 3]], emitted: f64, tolerance: f64) -> f64 {
+    let area = mesh.total_area().max(f64::MIN_POSITIVE);
+    let rho_mean: f64 = mesh
+        .patches
+        .iter()
+        .zip(rho)
+        .map(|(p, r)| scalar(r) * p.area)
+        .sum::<f64>()
+        / area;
+    let n = mesh.patches.len().max(1) as f64;
+    emitted * tolerance * tolerance / (n * (1.0 - rho_mean).max(1e-3))
+}
+
+/// The rays a shot of scalar flux `flux` casts: X = ΔΦ / C, laid out on the polar grid.
+pub fn grid_for(flux: f64, energy_per_ray: f64) -> PolarGrid {
+    PolarGrid::for_samples(flux / energy_per_ray)
+}
+
+/// One ray shot of a wave.
+pub(super) struct RayShot {
+    pub patch: usize,
+    /// Global shot number (seeds its random numbers).
+    pub index: u64,
+    /// The flux it shoots, RGB.
+    pub phi: [f64; 3],
+    /// The same per light channel (empty without `--per-light`).
+    pub ch: Vec<[f64; 3]>,
+    pub grid: PolarGrid,
+}
+
+/// Draws points uniformly over the area of one convex patch: a fan triangle chosen by area,
+/// then a uniform point in it. Built once per chunk of rays, so no work per ray but the draw.
+struct PatchPoints {
+    apex: Vec3,
+    /// (b, c, cumulative area) of each fan triangle (apex, b, c).
+    fan: Vec<(Vec3, Vec3, f32)>,
+}
+
+impl PatchPoints {
+    fn new(mesh: &Mesh, i: usize) -> PatchPoints {
+        let ids = mesh.patch_indices(i);
+        let v = |k: usize| mesh.vertices[ids[k] as usize];
+        let apex = v(0);
+        let mut total = 0.0;
+        let fan = (1..ids.len() - 1)
+            .map(|k| {
+                total += (v(k) - apex).cross(v(k + 1) - apex).length();
+                (v(k), v(k + 1), total)
+            })
+            .collect();
+        PatchPoints { apex, fan }
+    }
+
+    #[inline]
+    fn sample<R: Rng>(&self, rng: &mut R) -> Vec3 {
+        let (mut b, mut c, _) = self.fan[0];
+        if self.fan.len() > 1 {
+            let u = rng.gen::<f32>() * self.fan[self.fan.len() - 1].2;
+            let k = self
+                .fan
+                .iter()
+                .position(|f| u < f.2)
+                .unwrap_or(self.fan.len() - 1);
+            (b, c) = (self.fan[k].0, self.fan[k].1);
+        }
+        let (r1, r2) = (rng.gen::<f32>().sqrt(), rng.gen::<f32>());
+        self.apex * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2)
+    }
+}
+
+/// Everything a ray shot needs to know about the scene, shared by all threads.
+pub(super) struct RayCaster<'a, I> {
+    mesh: &'a Mesh,
+    isect: &'a I,
+    seed: u64,
+    jitter: bool,
+    /// Smallest offset of ray origins off their patch: a few ulps of the largest coordinate.
+    eps_floor: f32,
+}
+
+impl<'a, I: Intersector> RayCaster<'a, I> {
+    pub fn new(mesh: &'a Mesh, isect: &'a I, seed: u64, jitter: bool) -> Self {
+        let reach = mesh
+            .vertices
+            .iter()
+            .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+        RayCaster {
+            mesh,
+            isect,
+            seed,
+            jitter,
+            eps_floor: reach * 5e-7,
+        }
+    }
+
+    /// Casts rays `first..first + count` of `shot` (its chunk `chunk`); a hit code per ray.
+    pub fn cast(&self, shot: &RayShot, chunk: usize, first: usize, count: usize) -> Vec<u32> {
+        let i = shot.patch;
+        let patch = &self.mesh.patches[i];
+        // Sec. 3: a random rotation of the sampling pattern about the normal, per shot.
+        let angle = rng_for(self.seed, shot.index, u64::MAX).gen::<f32>() * std::f32::consts::TAU;
+        let frame = Frame::new(patch.normal, angle);
+        let mut rng = rng_for(self.seed, shot.index, chunk as u64);
+        let eps = (1e-4 * (patch.area as f32).sqrt()).max(self.eps_floor);
+        let points = PatchPoints::new(self.mesh, i);
+        let mut out = Vec::with_capacity(count);
+        for k in first..first + count {
+            let dir = frame.to_world(shot.grid.direction(k, 0.0, self.jitter, &mut rng));
+            let org = points.sample(&mut rng) + patch.normal * eps;
+            out.push(self.trace(i, org, dir, eps));
+        }
+        out
+    }
+
+    fn trace(&self, shooter: usize, org: Vec3, dir: Vec3, eps: f32) -> u32 {
+        let mut ray = Ray {
+            org,
+            dir,
+            tnear: 0.0,
+            tfar: f32::INFINITY,
+        };
+        // A ray leaving its own (planar, convex) patch cannot meet it again; if rounding says
+        // otherwise, step past it.
+        for _ in 0..3 {
+            match self.isect.intersect(&ray) {
+                None => return ESCAPED,
+                Some(h) if h.patch as usize == shooter => ray.tnear = h.t + eps,
+                Some(h) if h.back => return h.patch | BACK,
+                Some(h) => return h.patch,
+            }
+        }
+        ESCAPED
+    }
+
+    /// Casts every ray of `shot` on the calling thread, not applied; returns how many.
+    pub fn cast_all(&self, shot: &RayShot) -> usize {
+        tasks_of(std::slice::from_ref(shot))
+            .iter()
+            .map(|t| self.cast(shot, t.chunk, t.first, t.count).len())
+            .sum()
+    }
+}
+
+/// Thread time (s) of ray shots from `shooters`, `rays_per_shot` rays each, cast on the calling
+/// thread exactly as the solver casts them (points over the patch, polar cells, rotation) but
+/// not applied: Sec. 4's cost of ray sampling, for `radiosity bench shots`. Returns the seconds
+/// and the rays cast.
+pub fn time_ray_shots<I: Intersector>(
+    mesh: &Mesh,
+    isect: &I,
+    shooters: &[usize],
+    rays_per_shot: usize,
+    seed: u64,
+) -> (f64, u64) {
+    let caster = RayCaster::new(mesh, isect, seed, true);
+    let t = Instant::now();
+    let mut rays = 0;
+    for (k, &i) in shooters.iter().enumerate() {
+        let shot = RayShot {
+            patch: i,
+            index: k as u64,
+            phi: [0.0; 3],
+            ch: Vec::new(),
+            grid: PolarGrid::for_samples(rays_per_shot as f64),
+        };
+        rays += caster.cast_all(&shot) as u64;
+    }
+    (t.elapsed().as_secs_f64(), rays)
+}
+
+/// Applies a wave's hits in task order: receivers gain ρ_j·ΔΦ_i/X, the rest is absorbed.
+pub(super) fn apply_rays(st: &mut State, wave: &[RayShot], tasks: &[Task], hits: &[Vec<u32>]) {
+    for (task, codes) in tasks.iter().zip(hits) {
+        let shot = &wave[task.shot];
+        let per_ray = 1.0 / shot.grid.len() as f64;
+        let phi_ray = shot.phi.map(|p| p * per_ray);
+        for &code in codes {
+            if code == ESCAPED {
+                st.escape(&phi_ray);
+            } else if code & BACK != 0 {
+                st.deposit_back(&phi_ray);
+            } else {
+                st.deposit(code as usize, &phi_ray);
+                if !shot.ch.is_empty() {
+                    st.deposit_channels(code as usize, &shot.ch, per_ray);
+                }
+            }
+        }
+        st.rays += codes.len() as u64;
+    }
+    st.finish_batch();
+}
+
+/// A chunk of one shot's rays: the unit of parallel work.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Task {
+    pub shot: usize,
+    pub chunk: usize,
+    pub first: usize,
+    pub count: usize,
+}
+
+/// The chunks of a wave's shots, in shot order.
+pub(super) fn tasks_of(wave: &[RayShot]) -> Vec<Task> {
+    wave.iter()
+        .enumerate()
+        .flat_map(|(s, shot)| {
+            let x = shot.grid.len();
+            (0..x.div_ceil(CHUNK)).map(move |c| Task {
+                shot: s,
+                chunk: c,
+                first: c * CHUNK,
+                count: CHUNK.min(x - c * CHUNK),
+            })
+        })
+        .collect()
+}

@@ -1,0 +1,99 @@
+//! Sec. 3 of Airey & Ouh-young (1989): when a shooting solve stops.
+//!
+//! "The refinement halted … at which point the maximum unshot radiosity was less than 0.06
+//! percent of the mean radiosity value. Nothing further can be shown on a 24 bit frame
+//! buffer." Here the unshot radiosity is weighed by what it will still add, all bounces
+//! counted ([`super::books::State::amplification`]): in a stiff scene (ρ near 1) unshot light
+//! is worth many times itself. Then the budgets (`max_time`, the one clock-dependent setting;
+//! `max_rays`, counted samples) and the interrupt flag, which is read only at safe points so a
+//! resumed run repeats the same shots.
+
+use super::{SolveSettings, StopReason};
+
+/// What the stop rule looks at, at the top of each step of the driver.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Progress {
+    /// Ctrl-C was seen at the last safe point.
+    pub interrupted: bool,
+    /// Max unshot radiosity (scalar, W/m²), over the patches above the stop threshold.
+    pub max_unshot_b: f64,
+    /// What a unit of unshot radiosity will still add ([`super::books::State::amplification`]).
+    pub amplification: f64,
+    /// Area-weighted mean radiosity (scalar, W/m²).
+    pub mean_b: f64,
+    /// Seconds since the solve started (counting the run it resumed).
+    pub elapsed: f64,
+    /// Form-factor samples so far: rays (cast, applied or in flight) plus hemi-cube cells.
+    pub samples: u64,
+}
+
+/// The verdict: `None` to go on. `has_unshot` says whether any unshot energy at all is left
+/// (asked only when the criterion holds: converged, or exhausted).
+pub(super) fn verdict(
+    cfg: &SolveSettings,
+    p: &Progress,
+    has_unshot: impl FnOnce() -> bool,
+) -> Option<StopReason> {
+    if p.interrupted {
+        Some(StopReason::Interrupted)
+    } else if p.max_unshot_b * p.amplification < cfg.stop_fraction * p.mean_b {
+        // The max-ΔB heap holds only patches above the threshold; whether any energy at all is
+        // left, the flux heap says.
+        if has_unshot() {
+            Some(StopReason::Converged)
+        } else {
+            Some(StopReason::Exhausted)
+        }
+    } else if cfg.max_time.is_some_and(|t| p.elapsed >= t) {
+        Some(StopReason::MaxTime)
+    } else if cfg.max_rays.is_some_and(|r| p.samples >= r) {
+        Some(StopReason::MaxRays)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn progress(max_unshot_b: f64) -> Progress {
+        Progress {
+            interrupted: false,
+            max_unshot_b,
+            amplification: 2.0,
+            mean_b: 1.0,
+            elapsed: 0.0,
+            samples: 0,
+        }
+    }
+
+    #[test]
+    fn stops_at_six_hundredths_of_a_percent_of_what_is_left_to_add() {
+        let cfg = SolveSettings::default();
+        // 0.0006 of the mean, with every unit of unshot radiosity worth two.
+        assert_eq!(verdict(&cfg, &progress(0.000_31), || true), None);
+        assert_eq!(
+            verdict(&cfg, &progress(0.000_29), || true),
+            Some(StopReason::Converged)
+        );
+        assert_eq!(
+            verdict(&cfg, &progress(0.0), || false),
+            Some(StopReason::Exhausted)
+        );
+        let budget = SolveSettings {
+            max_rays: Some(10),
+            ..cfg.clone()
+        };
+        let p = Progress {
+            samples: 10,
+            ..progress(1.0)
+        };
+        assert_eq!(verdict(&budget, &p, || true), Some(StopReason::MaxRays));
+        let p = Progress {
+            interrupted: true,
+            ..p
+        };
+        assert_eq!(verdict(&budget, &p, || true), Some(StopReason::Interrupted));
+    }
+}
