@@ -541,6 +541,153 @@ struct Tally {
     pairs: Vec<PairReport>,
 }
 
+impl Tally {
+    /// Zero counts for every intersector in `names` and every pair in `pairs`.
+    fn empty(names: &[&str], pairs: &[(usize, usize)]) -> Tally {
+        Tally {
+            casters: names
+                .iter()
+                .map(|n| IntersectorReport {
+                    name: n.to_string(),
+                    ..Default::default()
+                })
+                .collect(),
+            pairs: pairs
+                .iter()
+                .map(|&(a, b)| PairReport {
+                    a: names[a].to_string(),
+                    b: names[b].to_string(),
+                    ..Default::default()
+                })
+                .collect(),
+        }
+    }
+
+    /// Counts one ray's `answers` (one per intersector): misses, then agreement of each pair.
+    fn record(
+        &mut self,
+        r: &TestRay,
+        answers: &[Option<Hit>],
+        pairs: &[(usize, usize)],
+        judge: &Judge<'_>,
+    ) {
+        for (k, rep) in self.casters.iter_mut().enumerate() {
+            let missed = answers[k].is_none() as u64;
+            if r.source == RaySource::Surface {
+                rep.surface_rays += 1;
+                rep.escapes += missed;
+            } else {
+                rep.uniform_misses += missed;
+            }
+        }
+        for (p, &(ia, ib)) in self.pairs.iter_mut().zip(pairs) {
+            let (a, b) = (answers[ia], answers[ib]);
+            p.rays += 1;
+            if a.map(|h| h.patch) == b.map(|h| h.patch) {
+                p.agreed += 1;
+                continue;
+            }
+            match judge.classify(r, a, b) {
+                Class::Edge => p.edge += 1,
+                Class::Grazing => p.grazing += 1,
+                Class::Coincident => p.coincident += 1,
+                Class::Real => {
+                    p.real += 1;
+                    if p.examples.len() < MAX_EXAMPLES {
+                        p.examples.push(Disagreement {
+                            ray: *r,
+                            a: a.map(Answer::from),
+                            b: b.map(Answer::from),
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds a later chunk's tallies to these (examples kept in chunk order).
+    fn add(&mut self, t: Tally) {
+        for (x, y) in self.casters.iter_mut().zip(t.casters) {
+            x.surface_rays += y.surface_rays;
+            x.escapes += y.escapes;
+            x.uniform_misses += y.uniform_misses;
+        }
+        for (x, y) in self.pairs.iter_mut().zip(t.pairs) {
+            x.add(y);
+        }
+    }
+}
+
+/// The intersectors to compare, Embree first and brute force (when it runs) last; `skew` is
+/// the number of skew patches. Also says whether brute force runs.
+fn build_casters(mesh: &Mesh, skew: usize) -> Result<(Vec<AnyIntersector>, bool), EmbreeError> {
+    let mut casters = vec![AnyIntersector::Embree(EmbreeScene::build(mesh, |_| true)?)];
+    if skew == 0 && !mesh.patches.is_empty() {
+        casters.push(AnyIntersector::Merge(PlaneMerge::build(mesh)));
+    }
+    casters.push(AnyIntersector::Hybrid(Hybrid::build(mesh)?));
+    let brute = mesh.patches.len() <= BRUTE_MAX_PATCHES;
+    if brute {
+        casters.push(AnyIntersector::Brute(BruteForce::new(mesh)));
+    }
+    Ok((casters, brute))
+}
+
+/// Pairs (a, b) of indices into `names`, b the reference: each against the reference, and the
+/// hybrid against Embree (index 0) when the reference is brute force.
+fn compared_pairs(names: &[&str], reference: usize, brute: bool) -> Vec<(usize, usize)> {
+    let mut pairs: Vec<(usize, usize)> = (0..names.len())
+        .filter(|&k| k != reference)
+        .map(|k| (k, reference))
+        .collect();
+    let hybrid = names
+        .iter()
+        .position(|n| *n == "hybrid")
+        .expect("always built");
+    if brute {
+        pairs.push((hybrid, 0));
+    }
+    pairs
+}
+
+/// Casts through every intersector all `rays` rays, in parallel chunks, and combines the
+/// chunks' tallies in chunk order (deterministic examples); sets each pair's agreement.
+fn cast_all(
+    casters: &[AnyIntersector],
+    names: &[&str],
+    pairs: &[(usize, usize)],
+    gen: &RayGen<'_>,
+    judge: &Judge<'_>,
+    rays: u64,
+    seed: u64,
+) -> Tally {
+    let tallies: Vec<Tally> = (0..rays.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            set_flush_denormals();
+            let mut batch = Vec::with_capacity(CHUNK as usize);
+            gen.chunk(seed, c, CHUNK.min(rays - c * CHUNK), &mut batch);
+            let mut t = Tally::empty(names, pairs);
+            let mut answers = vec![None; casters.len()];
+            for r in &batch {
+                for (a, c) in answers.iter_mut().zip(casters) {
+                    *a = trace(c, r);
+                }
+                t.record(r, &answers, pairs, judge);
+            }
+            t
+        })
+        .collect();
+    let mut total = Tally::empty(names, pairs);
+    for t in tallies {
+        total.add(t);
+    }
+    for p in &mut total.pairs {
+        p.agreement = p.agreed as f64 / (p.rays.max(1)) as f64;
+    }
+    total
+}
+
 /// Casts `rays` test rays through every intersector the scene supports — Embree over the whole
 /// scene, the plane merge alone when every patch is axis-aligned, the hybrid (plane merge +
 /// Embree over the skew patches) and, on scenes of ≤ [`BRUTE_MAX_PATCHES`] patches, brute force
@@ -554,115 +701,16 @@ pub fn crosscheck(mesh: &Mesh, rays: u64, seed: u64, eps: f32) -> Result<CrossRe
         .iter()
         .filter(|p| p.class == PatchClass::Skew)
         .count();
-    let mut casters = vec![AnyIntersector::Embree(EmbreeScene::build(mesh, |_| true)?)];
-    if skew == 0 && !mesh.patches.is_empty() {
-        casters.push(AnyIntersector::Merge(PlaneMerge::build(mesh)));
-    }
-    casters.push(AnyIntersector::Hybrid(Hybrid::build(mesh)?));
-    let brute = mesh.patches.len() <= BRUTE_MAX_PATCHES;
-    if brute {
-        casters.push(AnyIntersector::Brute(BruteForce::new(mesh)));
-    }
+    let (casters, brute) = build_casters(mesh, skew)?;
     let names: Vec<&str> = casters.iter().map(|c| c.name()).collect();
     // Brute force is last when it ran; Embree is first.
     let reference = if brute { names.len() - 1 } else { 0 };
-    // Pairs (a, b), b the reference: each against the reference, and the hybrid against Embree
-    // when the reference is brute force.
-    let mut pairs: Vec<(usize, usize)> = (0..names.len())
-        .filter(|&k| k != reference)
-        .map(|k| (k, reference))
-        .collect();
-    let hybrid = names
-        .iter()
-        .position(|n| *n == "hybrid")
-        .expect("always built");
-    if brute {
-        pairs.push((hybrid, 0));
-    }
+    let pairs = compared_pairs(&names, reference, brute);
     let (lo, hi) = bounds(mesh);
     let scene_size = (hi - lo).as_dvec3().length();
     let judge = Judge::new(mesh, eps);
     let gen = RayGen::new(mesh);
-    let empty = || Tally {
-        casters: names
-            .iter()
-            .map(|n| IntersectorReport {
-                name: n.to_string(),
-                ..Default::default()
-            })
-            .collect(),
-        pairs: pairs
-            .iter()
-            .map(|&(a, b)| PairReport {
-                a: names[a].to_string(),
-                b: names[b].to_string(),
-                ..Default::default()
-            })
-            .collect(),
-    };
-    let tallies: Vec<Tally> = (0..rays.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| {
-            set_flush_denormals();
-            let mut batch = Vec::with_capacity(CHUNK as usize);
-            gen.chunk(seed, c, CHUNK.min(rays - c * CHUNK), &mut batch);
-            let mut t = empty();
-            let mut answers = vec![None; casters.len()];
-            for r in &batch {
-                for (a, c) in answers.iter_mut().zip(&casters) {
-                    *a = trace(c, r);
-                }
-                for (k, rep) in t.casters.iter_mut().enumerate() {
-                    let missed = answers[k].is_none() as u64;
-                    if r.source == RaySource::Surface {
-                        rep.surface_rays += 1;
-                        rep.escapes += missed;
-                    } else {
-                        rep.uniform_misses += missed;
-                    }
-                }
-                for (p, &(ia, ib)) in t.pairs.iter_mut().zip(&pairs) {
-                    let (a, b) = (answers[ia], answers[ib]);
-                    p.rays += 1;
-                    if a.map(|h| h.patch) == b.map(|h| h.patch) {
-                        p.agreed += 1;
-                        continue;
-                    }
-                    match judge.classify(r, a, b) {
-                        Class::Edge => p.edge += 1,
-                        Class::Grazing => p.grazing += 1,
-                        Class::Coincident => p.coincident += 1,
-                        Class::Real => {
-                            p.real += 1;
-                            if p.examples.len() < MAX_EXAMPLES {
-                                p.examples.push(Disagreement {
-                                    ray: *r,
-                                    a: a.map(Answer::from),
-                                    b: b.map(Answer::from),
-                                });
-                            }
-                        }
-                    }
-                }
-            }
-            t
-        })
-        .collect();
-    // Combine in chunk order (deterministic examples).
-    let mut total = empty();
-    for t in tallies {
-        for (x, y) in total.casters.iter_mut().zip(t.casters) {
-            x.surface_rays += y.surface_rays;
-            x.escapes += y.escapes;
-            x.uniform_misses += y.uniform_misses;
-        }
-        for (x, y) in total.pairs.iter_mut().zip(t.pairs) {
-            x.add(y);
-        }
-    }
-    for p in &mut total.pairs {
-        p.agreement = p.agreed as f64 / (p.rays.max(1)) as f64;
-    }
+    let total = cast_all(&casters, &names, &pairs, &gen, &judge, rays, seed);
     let mut report = CrossReport {
         patches: mesh.patches.len(),
         axial_patches: mesh.patches.len() - skew,

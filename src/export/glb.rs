@@ -114,7 +114,23 @@ pub fn write(
         return Err(io::Error::other("vertex colours do not match the mesh"));
     }
     let exposure = vertex_exposure(vertex_b, exposure);
-    let n = mesh.vertices.len();
+    let mut root = new_root(generator, exposure);
+    let mut bin = Vec::new();
+    let primitive = push_accessors(&mut root, &mut bin, mesh, vertex_b, exposure);
+    push_scene(&mut root, primitive);
+    root.push(json::Buffer {
+        byte_length: USize64::from(bin.len()),
+        extensions: Default::default(),
+        extras: Default::default(),
+        name: None,
+        uri: None,
+    });
+    write_chunks(w, &root, bin)?;
+    Ok(exposure)
+}
+
+/// The bounding box of the vertices (zero for an empty mesh), for `POSITION`'s min/max.
+fn bounds(mesh: &Mesh) -> ([f32; 3], [f32; 3]) {
     let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
     for v in &mesh.vertices {
         for c in 0..3 {
@@ -122,10 +138,14 @@ pub fn write(
             hi[c] = hi[c].max(v[c]);
         }
     }
-    if n == 0 {
+    if mesh.vertices.is_empty() {
         (lo, hi) = ([0.0; 3], [0.0; 3]);
     }
+    (lo, hi)
+}
 
+/// An empty document whose asset names the generator and records the exposure in `extras`.
+fn new_root(generator: &str, exposure: f32) -> json::Root {
     let mut root = json::Root::default();
     root.asset.generator = Some(generator.to_string());
     root.asset.extras = serde_json::value::to_raw_value(&serde_json::json!({
@@ -134,46 +154,69 @@ pub fn write(
         "radiosity_attribute": format!("_{RADIOSITY_ATTRIBUTE}"),
     }))
     .ok();
-    let mut bin = Vec::new();
+    root
+}
+
+/// The accessors of the one primitive: its vertex attributes and its triangle indices.
+struct Primitive {
+    attributes:
+        BTreeMap<json::validation::Checked<json::mesh::Semantic>, json::Index<json::Accessor>>,
+    indices: json::Index<json::Accessor>,
+}
+
+/// Appends the vertex data and indices to `bin`, each with its view and accessor, in the
+/// order position, normal, colour, radiosity, indices.
+fn push_accessors(
+    root: &mut json::Root,
+    bin: &mut Vec<u8>,
+    mesh: &Mesh,
+    vertex_b: &[[f32; 3]],
+    exposure: f32,
+) -> Primitive {
     use json::accessor::{ComponentType as C, Type as T};
     use json::buffer::Target;
-    let pos = push_view(
-        &mut root,
-        &mut bin,
-        &f32_bytes(mesh.vertices.iter().map(|v| v.to_array())),
-        Target::ArrayBuffer,
+    let n = mesh.vertices.len();
+    let mut vec3 = |root: &mut json::Root, data: Vec<u8>, bounds| {
+        let view = push_view(root, bin, &data, Target::ArrayBuffer);
+        root.push(accessor(view, n, C::F32, T::Vec3, bounds))
+    };
+    let pos = vec3(
+        root,
+        f32_bytes(mesh.vertices.iter().map(|v| v.to_array())),
+        Some(bounds(mesh)),
     );
-    let pos = root.push(accessor(pos, n, C::F32, T::Vec3, Some((lo, hi))));
-    let nrm = push_view(
-        &mut root,
-        &mut bin,
-        &f32_bytes(vertex_normals(mesh).into_iter()),
-        Target::ArrayBuffer,
+    let nrm = vec3(root, f32_bytes(vertex_normals(mesh).into_iter()), None);
+    let col = vec3(
+        root,
+        f32_bytes(vertex_b.iter().map(|b| exposed(*b, exposure))),
+        None,
     );
-    let nrm = root.push(accessor(nrm, n, C::F32, T::Vec3, None));
-    let col = push_view(
-        &mut root,
-        &mut bin,
-        &f32_bytes(vertex_b.iter().map(|b| exposed(*b, exposure))),
-        Target::ArrayBuffer,
-    );
-    let col = root.push(accessor(col, n, C::F32, T::Vec3, None));
-    let rad = push_view(
-        &mut root,
-        &mut bin,
-        &f32_bytes(vertex_b.iter().copied()),
-        Target::ArrayBuffer,
-    );
-    let rad = root.push(accessor(rad, n, C::F32, T::Vec3, None));
+    let rad = vec3(root, f32_bytes(vertex_b.iter().copied()), None);
     let indices: Vec<u8> = mesh
         .triangles()
         .flat_map(|(t, _)| t)
         .flat_map(u32::to_le_bytes)
         .collect();
     let count = indices.len() / 4;
-    let idx = push_view(&mut root, &mut bin, &indices, Target::ElementArrayBuffer);
+    let idx = push_view(root, bin, &indices, Target::ElementArrayBuffer);
     let idx = root.push(accessor(idx, count, C::U32, T::Scalar, None));
 
+    let mut attributes = BTreeMap::new();
+    attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
+    attributes.insert(Valid(json::mesh::Semantic::Normals), nrm);
+    attributes.insert(Valid(json::mesh::Semantic::Colors(0)), col);
+    attributes.insert(
+        Valid(json::mesh::Semantic::Extras(RADIOSITY_ATTRIBUTE.into())),
+        rad,
+    );
+    Primitive {
+        attributes,
+        indices: idx,
+    }
+}
+
+/// Adds the unlit material, the mesh with its one primitive, its node and the scene.
+fn push_scene(root: &mut json::Root, primitive: Primitive) {
     let material = root.push(json::Material {
         name: Some("radiosity (unlit vertex colours)".into()),
         pbr_metallic_roughness: json::material::PbrMetallicRoughness {
@@ -187,23 +230,15 @@ pub fn write(
         ..Default::default()
     });
     root.extensions_used.push("KHR_materials_unlit".into());
-    let mut attributes = BTreeMap::new();
-    attributes.insert(Valid(json::mesh::Semantic::Positions), pos);
-    attributes.insert(Valid(json::mesh::Semantic::Normals), nrm);
-    attributes.insert(Valid(json::mesh::Semantic::Colors(0)), col);
-    attributes.insert(
-        Valid(json::mesh::Semantic::Extras(RADIOSITY_ATTRIBUTE.into())),
-        rad,
-    );
     let gl_mesh = root.push(json::Mesh {
         extensions: Default::default(),
         extras: Default::default(),
         name: Some("radiosity".into()),
         primitives: vec![json::mesh::Primitive {
-            attributes,
+            attributes: primitive.attributes,
             extensions: Default::default(),
             extras: Default::default(),
-            indices: Some(idx),
+            indices: Some(primitive.indices),
             material: Some(material),
             mode: Valid(json::mesh::Mode::Triangles),
             targets: None,
@@ -221,15 +256,11 @@ pub fn write(
         nodes: vec![node],
     });
     root.scene = Some(scene);
-    root.push(json::Buffer {
-        byte_length: USize64::from(bin.len()),
-        extensions: Default::default(),
-        extras: Default::default(),
-        name: None,
-        uri: None,
-    });
+}
 
-    let json_text = json::serialize::to_vec(&root).map_err(io::Error::other)?;
+/// Serialises the document and writes the GLB header, JSON chunk and binary chunk.
+fn write_chunks(w: &mut dyn Write, root: &json::Root, bin: Vec<u8>) -> io::Result<()> {
+    let json_text = json::serialize::to_vec(root).map_err(io::Error::other)?;
     // GLB stores its length in 32 bits.
     if (json_text.len() + bin.len() + 64) as u64 > u32::MAX as u64 {
         return Err(io::Error::other(
@@ -246,6 +277,5 @@ pub fn write(
         json: json_text.into(),
         bin: Some(bin.into()),
     };
-    glb.to_writer(w).map_err(io::Error::other)?;
-    Ok(exposure)
+    glb.to_writer(w).map_err(io::Error::other)
 }

@@ -65,9 +65,10 @@ pub(super) struct Plan {
     pub(super) rise: i64,
 }
 
+/// Draws the storey's layout: the room depth, the room widths of both rows, then each row's
+/// doorways (the random draws in that order).
 pub(super) fn plan(opts: &BuildingOptions, rng: &mut Pcg64Mcg) -> Plan {
     let floors = opts.floors as i64;
-    let rooms = opts.rooms_per_floor as i64;
     let has_stair = floors >= 2;
     // Room depth: a multiple of 10 mm so the attic's half width is a multiple of 5 mm; deep
     // enough for a flight and its landings when there are stairs.
@@ -76,6 +77,45 @@ pub(super) fn plan(opts: &BuildingOptions, rng: &mut Pcg64Mcg) -> Plan {
     } else {
         3850 + 100 * rng.gen_range(0..9i64)
     };
+    let (south_w, north_w, inner) = row_widths(opts, has_stair, rng);
+    let lx = inner + 2 * WALL;
+
+    let south_z = (WALL, WALL + depth);
+    let cz = (south_z.1 + WALL, south_z.1 + WALL + CORRIDOR);
+    let north_z = (cz.1 + WALL, cz.1 + WALL + depth);
+    let lz = if north_w.is_empty() {
+        cz.1 + WALL
+    } else {
+        north_z.1 + WALL
+    };
+    let mut rows = Vec::new();
+    for (ws, z, south) in [(south_w, south_z, true), (north_w, north_z, false)] {
+        if ws.is_empty() {
+            continue;
+        }
+        rows.push(row(&ws, z, south, has_stair, depth, rng));
+    }
+    let half = (lz - 2 * WALL) / 2;
+    debug_assert_eq!(half % ROOF_RUN, 0);
+    Plan {
+        floors,
+        lx,
+        lz,
+        rows,
+        cz,
+        half,
+        rise: half / ROOF_RUN * ROOF_RISE,
+    }
+}
+
+/// The unit widths of the south and north rows (the stair room first in the north row) and
+/// the rows' common interior length.
+fn row_widths(
+    opts: &BuildingOptions,
+    has_stair: bool,
+    rng: &mut Pcg64Mcg,
+) -> (Vec<i64>, Vec<i64>, i64) {
+    let rooms = opts.rooms_per_floor as i64;
     // Units (rooms and the stair room) split evenly between the rows, the stair room first in
     // the north row; both rows are then fitted to their mean length (room widths scaled, the
     // stair room kept), so the building grows by about one room per room asked for.
@@ -90,13 +130,6 @@ pub(super) fn plan(opts: &BuildingOptions, rng: &mut Pcg64Mcg) -> Plan {
     let mut south_w = widths(south_n, rng);
     let mut north_w = widths(north_n, rng);
     let stair_w = if has_stair { STAIR_ROOM_W + WALL } else { 0 };
-    let row_len = |w: &[i64], fixed: i64| {
-        if w.is_empty() {
-            (fixed - WALL).max(0)
-        } else {
-            w.iter().sum::<i64>() + WALL * (w.len() as i64 - 1) + fixed
-        }
-    };
     let south_len = row_len(&south_w, 0);
     let north_len = row_len(&north_w, stair_w);
     let mut inner = if north_len == 0 {
@@ -108,22 +141,8 @@ pub(super) fn plan(opts: &BuildingOptions, rng: &mut Pcg64Mcg) -> Plan {
     inner = inner
         .max(row_len(&vec![2100; south_w.len()], 0))
         .max(row_len(&vec![2100; north_w.len()], stair_w));
-    let fit = |w: &mut Vec<i64>, fixed: i64| {
-        if w.is_empty() {
-            return;
-        }
-        let target = inner - fixed - WALL * (w.len() as i64 - 1);
-        let sum: i64 = w.iter().sum();
-        for x in w.iter_mut() {
-            *x = *x * target / sum;
-        }
-        let rest = target - w.iter().sum::<i64>();
-        if let Some(last) = w.last_mut() {
-            *last += rest;
-        }
-    };
-    fit(&mut south_w, 0);
-    fit(&mut north_w, stair_w);
+    fit(&mut south_w, 0, inner);
+    fit(&mut north_w, stair_w, inner);
     if has_stair {
         // The stair room leads its row; alone, it takes the whole row.
         let w = if north_w.is_empty() {
@@ -133,64 +152,76 @@ pub(super) fn plan(opts: &BuildingOptions, rng: &mut Pcg64Mcg) -> Plan {
         };
         north_w.insert(0, w);
     }
-    let lx = inner + 2 * WALL;
+    (south_w, north_w, inner)
+}
 
-    let south_z = (WALL, WALL + depth);
-    let cz = (south_z.1 + WALL, south_z.1 + WALL + CORRIDOR);
-    let north_z = (cz.1 + WALL, cz.1 + WALL + depth);
-    let lz = if north_w.is_empty() {
-        cz.1 + WALL
+/// Interior length of a row of rooms of widths `w` with walls between them, plus `fixed`.
+fn row_len(w: &[i64], fixed: i64) -> i64 {
+    if w.is_empty() {
+        (fixed - WALL).max(0)
     } else {
-        north_z.1 + WALL
-    };
-    let mut rows = Vec::new();
-    for (ws, (z0, z1), south) in [(south_w, south_z, true), (north_w, north_z, false)] {
-        if ws.is_empty() {
-            continue;
-        }
-        let mut units = Vec::new();
-        let mut x = WALL;
-        for (k, &w) in ws.iter().enumerate() {
-            let stair = has_stair && !south && k == 0;
-            let door = if stair {
-                let c = x + (LANES[0].1 + LANES[1].0) / 2;
-                (c - DOOR_W / 2, c + DOOR_W / 2)
-            } else {
-                let d0 = x + 300 + rng.gen_range(0..=(w - 1200 - 300));
-                (d0, d0 + DOOR_W)
-            };
-            units.push(Unit {
-                x0: x,
-                x1: x + w,
-                stair,
-                door,
-                next_door: None,
-            });
-            x += w + WALL;
-        }
-        // Doorways between neighbouring rooms (never into the stair room).
-        for k in 0..units.len().saturating_sub(1) {
-            if !units[k].stair && !units[k + 1].stair && rng.gen_bool(0.35) {
-                let d0 = z0 + 300 + rng.gen_range(0..=(depth - 1200 - 300));
-                units[k].next_door = Some((d0, d0 + DOOR_W));
-            }
-        }
-        rows.push(Row {
-            z0,
-            z1,
-            south,
-            units,
-        });
+        w.iter().sum::<i64>() + WALL * (w.len() as i64 - 1) + fixed
     }
-    let half = (lz - 2 * WALL) / 2;
-    debug_assert_eq!(half % ROOF_RUN, 0);
-    Plan {
-        floors,
-        lx,
-        lz,
-        rows,
-        cz,
-        half,
-        rise: half / ROOF_RUN * ROOF_RISE,
+}
+
+/// Scales the widths `w` so that the row (plus `fixed`) is `inner` long, the last room taking
+/// the rounding.
+fn fit(w: &mut [i64], fixed: i64, inner: i64) {
+    if w.is_empty() {
+        return;
+    }
+    let target = inner - fixed - WALL * (w.len() as i64 - 1);
+    let sum: i64 = w.iter().sum();
+    for x in w.iter_mut() {
+        *x = *x * target / sum;
+    }
+    let rest = target - w.iter().sum::<i64>();
+    if let Some(last) = w.last_mut() {
+        *last += rest;
+    }
+}
+
+/// One row of units of widths `ws` from x = WALL: the stair room's doorway between the lanes,
+/// each room's at random; then doorways between neighbouring rooms, at random.
+fn row(
+    ws: &[i64],
+    (z0, z1): (i64, i64),
+    south: bool,
+    has_stair: bool,
+    depth: i64,
+    rng: &mut Pcg64Mcg,
+) -> Row {
+    let mut units = Vec::new();
+    let mut x = WALL;
+    for (k, &w) in ws.iter().enumerate() {
+        let stair = has_stair && !south && k == 0;
+        let door = if stair {
+            let c = x + (LANES[0].1 + LANES[1].0) / 2;
+            (c - DOOR_W / 2, c + DOOR_W / 2)
+        } else {
+            let d0 = x + 300 + rng.gen_range(0..=(w - 1200 - 300));
+            (d0, d0 + DOOR_W)
+        };
+        units.push(Unit {
+            x0: x,
+            x1: x + w,
+            stair,
+            door,
+            next_door: None,
+        });
+        x += w + WALL;
+    }
+    // Doorways between neighbouring rooms (never into the stair room).
+    for k in 0..units.len().saturating_sub(1) {
+        if !units[k].stair && !units[k + 1].stair && rng.gen_bool(0.35) {
+            let d0 = z0 + 300 + rng.gen_range(0..=(depth - 1200 - 300));
+            units[k].next_door = Some((d0, d0 + DOOR_W));
+        }
+    }
+    Row {
+        z0,
+        z1,
+        south,
+        units,
     }
 }

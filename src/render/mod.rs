@@ -18,70 +18,20 @@
 //! Rasterization is watertight: each shared edge is evaluated with its endpoints in a canonical
 //! order and clipped from its inside endpoint, so neighbouring triangles leave no cracks.
 
+mod camera;
 pub mod false_colour;
 pub mod glyphs;
+mod raster;
+mod tone;
 pub mod view;
 
+pub use camera::Camera;
+pub use tone::{auto_exposure, srgb_encode, tone_map};
 pub use view::{CameraSpec, ViewSettings};
 
 use crate::mesh::Mesh;
 use glam::Vec3;
-use rayon::prelude::*;
-
-/// A pinhole camera.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    pub eye: Vec3,
-    pub target: Vec3,
-    pub up: Vec3,
-    /// Vertical field of view in degrees (clamped to 0.01..179 when used).
-    pub fov_y_deg: f32,
-}
-
-impl Camera {
-    /// Fitted to the scene: looks along -z from the +z side (y up), fov 40°, distance so the whole
-    /// bounding box fits in view with a small margin, aimed at the box centre.
-    ///
-    /// A non-finite or inverted box (such as the bounds of an empty mesh) is replaced by the unit
-    /// cube around the origin; a non-positive or non-finite `aspect` (width / height) by 1.
-    pub fn fit(lo: Vec3, hi: Vec3, aspect: f32) -> Camera {
-        let (lo, hi) = if lo.is_finite() && hi.is_finite() && lo.cmple(hi).all() {
-            (lo, hi)
-        } else {
-            (Vec3::splat(-0.5), Vec3::splat(0.5))
-        };
-        let aspect = if aspect.is_finite() && aspect > 0.0 {
-            aspect
-        } else {
-            1.0
-        };
-        let fov_y_deg = 40.0_f32;
-        let tan_y = (0.5 * fov_y_deg).to_radians().tan();
-        let tan_x = tan_y * aspect;
-        // Corners end up at most 1/MARGIN of the way from the image centre to its edge.
-        const MARGIN: f32 = 1.1;
-        let centre = 0.5 * (lo + hi);
-        let h = 0.5 * (hi - lo);
-        // With the eye at centre + d·z, a corner at offset (x, y, z) lies at depth d − z and is
-        // in view when |x| ≤ (d − z)·tan_x / MARGIN (same for y): solve each for d.
-        let mut d: f32 = 0.0;
-        for z in [-h.z, h.z] {
-            d = d
-                .max(z + MARGIN * h.x / tan_x)
-                .max(z + MARGIN * h.y / tan_y);
-        }
-        // Keep the box's near face well in front of the eye even when the box is flat.
-        let extent = h.length();
-        let gap = if extent > 0.0 { 0.1 * extent } else { 1.0 };
-        d = d.max(h.z + gap);
-        Camera {
-            eye: centre + Vec3::new(0.0, 0.0, d),
-            target: centre,
-            up: Vec3::Y,
-            fov_y_deg,
-        }
-    }
-}
+use raster::{draw_bands, screen_triangles, View};
 
 /// Output size and quality of [`render_linear`].
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -114,107 +64,6 @@ pub struct LinearImage {
     pub pixels: Vec<[f32; 3]>,
 }
 
-/// Output rows per rayon task (times the supersampling factor in sample rows).
-const BAND_ROWS: usize = 8;
-/// Side clip planes sit this factor outside the view, so clipping never shows at the border.
-const GUARD: f32 = 1.01;
-
-/// The camera's view transform and projection onto a sample grid.
-struct View {
-    eye: Vec3,
-    right: Vec3,
-    up: Vec3,
-    fwd: Vec3,
-    tan_x: f32,
-    tan_y: f32,
-    width: f32,
-    height: f32,
-}
-
-impl View {
-    /// Builds an orthonormal basis; a degenerate camera (eye == target, up parallel to the view
-    /// direction, non-finite values) falls back to looking along -z and to another up vector.
-    fn new(camera: &Camera, width: usize, height: usize) -> View {
-        let eye = camera.eye;
-        let mut fwd = (camera.target - eye).normalize_or_zero();
-        if fwd == Vec3::ZERO {
-            fwd = Vec3::NEG_Z;
-        }
-        let mut right = Vec3::X;
-        for up in [camera.up, Vec3::Y, Vec3::Z, Vec3::X] {
-            let r = fwd.cross(up.normalize_or_zero());
-            // sin of the angle between fwd and up above 1e-3: the basis is well conditioned.
-            if r.is_finite() && r.length_squared() > 1e-6 {
-                right = r.normalize();
-                break;
-            }
-        }
-        let fov = if camera.fov_y_deg.is_finite() {
-            camera.fov_y_deg.clamp(0.01, 179.0)
-        } else {
-            40.0
-        };
-        let tan_y = (0.5 * fov).to_radians().tan();
-        let aspect = if height > 0 {
-            width as f32 / height as f32
-        } else {
-            1.0
-        };
-        View {
-            eye,
-            right,
-            up: right.cross(fwd),
-            fwd,
-            tan_x: tan_y * aspect,
-            tan_y,
-            width: width as f32,
-            height: height as f32,
-        }
-    }
-
-    /// World → view space: x right, y up, z = depth along the view direction.
-    fn to_view(&self, p: Vec3) -> Vec3 {
-        let d = p - self.eye;
-        Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.fwd))
-    }
-
-    /// View space (z > 0) → sample-grid coordinates, y down, pixel centres at +0.5.
-    fn to_screen(&self, v: Vec3) -> [f32; 2] {
-        [
-            (0.5 + 0.5 * v.x / (v.z * self.tan_x)) * self.width,
-            (0.5 - 0.5 * v.y / (v.z * self.tan_y)) * self.height,
-        ]
-    }
-
-    /// The five clip planes (n, d), inside where n·p + d ≥ 0: near, then the guard band.
-    fn planes(&self, near: f32) -> [(Vec3, f32); 5] {
-        let (gx, gy) = (GUARD * self.tan_x, GUARD * self.tan_y);
-        [
-            (Vec3::Z, -near),
-            (Vec3::new(1.0, 0.0, gx), 0.0),
-            (Vec3::new(-1.0, 0.0, gx), 0.0),
-            (Vec3::new(0.0, 1.0, gy), 0.0),
-            (Vec3::new(0.0, -1.0, gy), 0.0),
-        ]
-    }
-}
-
-/// A polygon vertex during clipping: view-space position and linear colour.
-#[derive(Clone, Copy)]
-struct ClipVert {
-    p: Vec3,
-    c: Vec3,
-}
-
-/// A projected triangle: sample-grid positions, 1/z and colour/z per vertex.
-#[derive(Clone, Copy)]
-struct ScreenTri {
-    x: [f32; 3],
-    y: [f32; 3],
-    w: [f32; 3],
-    cw: [Vec3; 3],
-}
-
 /// Renders `mesh` with per-vertex radiosity `vertex_rgb` (one entry per `mesh.vertices` element,
 /// linear W/m²) into a linear image. Non-finite colours and missing entries count as 0; patches
 /// with out-of-range indices or non-finite vertices are skipped. A zero width or height gives an
@@ -235,86 +84,10 @@ pub fn render_linear(
         };
     }
     let s = opts.supersample.clamp(1, 16) as usize;
-    let (ws, hs) = (width * s, height * s);
-    let view = View::new(camera, ws, hs);
-
-    // Near plane relative to the scene size; depth is tested on 1/z, which keeps its relative
-    // precision at any distance, so a small near plane costs nothing.
-    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for v in mesh.vertices.iter().filter(|v| v.is_finite()) {
-        lo = lo.min(*v);
-        hi = hi.max(*v);
-    }
-    let diag = (hi - lo).length();
-    let near = if diag.is_finite() && diag > 0.0 {
-        (1e-5 * diag).max(1e-7)
-    } else {
-        1e-4
-    };
-    let planes = view.planes(near);
-
-    // Cull, clip and project every patch (in parallel, order kept so results are deterministic).
-    let tris: Vec<ScreenTri> = mesh
-        .patches
-        .par_chunks(2048)
-        .map(|chunk| {
-            let (mut out, mut poly, mut tmp) = (Vec::new(), Vec::new(), Vec::new());
-            for patch in chunk {
-                let first = patch.first as usize;
-                let Some(idx) = first
-                    .checked_add(patch.count as usize)
-                    .and_then(|end| mesh.patch_vertices.get(first..end))
-                else {
-                    continue;
-                };
-                if patch_polygon(mesh, vertex_rgb, idx, patch.normal, &view, &mut poly) {
-                    clip_polygon(&mut poly, &mut tmp, &planes);
-                    project_fan(&poly, &view, &mut out);
-                }
-            }
-            out
-        })
-        .flatten_iter()
-        .collect();
-
-    // Bin triangles by band of sample rows.
-    let band_samples = BAND_ROWS * s;
-    let n_bands = height.div_ceil(BAND_ROWS);
-    let mut bins: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
-    for (i, t) in tris.iter().enumerate() {
-        let (r0, r1) = sample_range(t.y, hs);
-        if r0 <= r1 {
-            for bin in &mut bins[r0 / band_samples..=(r1 / band_samples).min(n_bands - 1)] {
-                bin.push(i as u32);
-            }
-        }
-    }
-
-    // Rasterize each band into its own buffers, then box-filter it into its output rows.
-    let inv_ss = 1.0 / (s * s) as f32;
-    pixels
-        .par_chunks_mut(BAND_ROWS * width)
-        .zip(bins.par_iter())
-        .enumerate()
-        .for_each(|(b, (out, bin))| {
-            let rows = out.len() / width * s;
-            let y0 = b * band_samples;
-            let mut colour = vec![Vec3::ZERO; rows * ws];
-            let mut depth = vec![0.0f32; rows * ws];
-            for &i in bin {
-                rasterize(&tris[i as usize], y0, rows, ws, &mut colour, &mut depth);
-            }
-            for (k, px) in out.iter_mut().enumerate() {
-                let (r, c) = (k / width, k % width);
-                let mut sum = Vec3::ZERO;
-                for sy in r * s..(r + 1) * s {
-                    sum += colour[sy * ws + c * s..sy * ws + (c + 1) * s]
-                        .iter()
-                        .sum::<Vec3>();
-                }
-                *px = (sum * inv_ss).to_array();
-            }
-        });
+    let view = View::new(camera, width * s, height * s);
+    let planes = view.planes(near_plane(mesh));
+    let tris = screen_triangles(mesh, vertex_rgb, &view, &planes);
+    draw_bands(&tris, &mut pixels, width, height, s);
     LinearImage {
         width: opts.width,
         height: opts.height,
@@ -322,232 +95,20 @@ pub fn render_linear(
     }
 }
 
-/// Fills `poly` with the view-space vertices of a front-facing patch; false if the patch is
-/// culled (back-facing or edge-on) or invalid.
-fn patch_polygon(
-    mesh: &Mesh,
-    vertex_rgb: &[[f32; 3]],
-    idx: &[u32],
-    normal: Vec3,
-    view: &View,
-    poly: &mut Vec<ClipVert>,
-) -> bool {
-    poly.clear();
-    for &i in idx {
-        let Some(&p) = mesh.vertices.get(i as usize) else {
-            return false;
-        };
-        if !p.is_finite() {
-            return false;
-        }
-        let c = vertex_rgb.get(i as usize).map_or(Vec3::ZERO, |c| {
-            Vec3::from_array(c.map(|x| if x.is_finite() { x } else { 0.0 }))
-        });
-        poly.push(ClipVert { p, c });
+/// The near plane's distance, relative to the size of the mesh's finite vertices: depth is
+/// tested on 1/z, which keeps its relative precision at any distance, so a small near plane
+/// costs nothing.
+fn near_plane(mesh: &Mesh) -> f32 {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for v in mesh.vertices.iter().filter(|v| v.is_finite()) {
+        lo = lo.min(*v);
+        hi = hi.max(*v);
     }
-    if poly.len() < 3 {
-        return false;
-    }
-    // The front normal as given, or from the winding (Newell) if that one is unusable.
-    let mut n = normal;
-    if !(n.is_finite() && n.length_squared() > 0.0) {
-        n = Vec3::ZERO;
-        for (k, a) in poly.iter().enumerate() {
-            n += a.p.cross(poly[(k + 1) % poly.len()].p);
-        }
-    }
-    if n.dot(view.eye - poly[0].p) <= 0.0 {
-        return false;
-    }
-    for v in poly.iter_mut() {
-        v.p = view.to_view(v.p);
-    }
-    true
-}
-
-/// Sutherland–Hodgman clipping of `poly` against each plane in turn (`tmp` is scratch).
-/// New vertices are interpolated from the inside endpoint, so an edge shared by two patches is
-/// cut at bit-identical points in both.
-fn clip_polygon(poly: &mut Vec<ClipVert>, tmp: &mut Vec<ClipVert>, planes: &[(Vec3, f32)]) {
-    for &(n, d) in planes {
-        if poly.len() < 3 {
-            poly.clear();
-            return;
-        }
-        tmp.clear();
-        for k in 0..poly.len() {
-            let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-            let (da, db) = (n.dot(a.p) + d, n.dot(b.p) + d);
-            if da >= 0.0 {
-                tmp.push(a);
-            }
-            if (da >= 0.0) != (db >= 0.0) {
-                let (inside, outside, di, dout) = if da >= 0.0 {
-                    (a, b, da, db)
-                } else {
-                    (b, a, db, da)
-                };
-                let t = di / (di - dout);
-                tmp.push(ClipVert {
-                    p: inside.p.lerp(outside.p, t),
-                    c: inside.c.lerp(outside.c, t),
-                });
-            }
-        }
-        std::mem::swap(poly, tmp);
-    }
-}
-
-/// Projects a clipped convex polygon and fan-triangulates it from its first vertex.
-fn project_fan(poly: &[ClipVert], view: &View, out: &mut Vec<ScreenTri>) {
-    if poly.len() < 3 {
-        return;
-    }
-    let proj = |v: &ClipVert| {
-        let [x, y] = view.to_screen(v.p);
-        let w = 1.0 / v.p.z;
-        (x, y, w, v.c * w)
-    };
-    let a = proj(&poly[0]);
-    for k in 1..poly.len() - 1 {
-        let (b, c) = (proj(&poly[k]), proj(&poly[k + 1]));
-        let t = ScreenTri {
-            x: [a.0, b.0, c.0],
-            y: [a.1, b.1, c.1],
-            w: [a.2, b.2, c.2],
-            cw: [a.3, b.3, c.3],
-        };
-        let area = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
-        let finite = t.x.iter().chain(&t.y).chain(&t.w).all(|v| v.is_finite())
-            && t.cw.iter().all(|c| c.is_finite());
-        if finite && area != 0.0 {
-            out.push(t);
-        }
-    }
-}
-
-/// The inclusive range of sample indices (centres at i + 0.5) in [0, n) within [min, max] of
-/// `coords`; empty (first > last) if none.
-fn sample_range(coords: [f32; 3], n: usize) -> (usize, usize) {
-    let lo = coords[0].min(coords[1]).min(coords[2]);
-    let hi = coords[0].max(coords[1]).max(coords[2]);
-    let first = (lo - 0.5).ceil().max(0.0);
-    let last = (hi - 0.5).floor().min(n as f32 - 1.0);
-    if first > last {
-        return (1, 0);
-    }
-    (first as usize, last as usize)
-}
-
-/// Z-buffered, perspective-correct rasterization of one triangle into the band of `rows`
-/// sample rows starting at sample row `y0`.
-fn rasterize(
-    t: &ScreenTri,
-    y0: usize,
-    rows: usize,
-    ws: usize,
-    colour: &mut [Vec3],
-    depth: &mut [f32],
-) {
-    let (c0, c1) = sample_range(t.x, ws);
-    let (r0, r1) = sample_range(t.y, y0 + rows);
-    let r0 = r0.max(y0);
-    if c0 > c1 || r0 > r1 {
-        return;
-    }
-    // Edge k is opposite vertex k. Its endpoints go in lexicographic order, so a shared edge is
-    // evaluated identically by both triangles (up to an exact sign flip): no cracks.
-    let mut edges = [(0.0f32, 0.0f32, 0.0f32, 0.0f32, 0.0f32); 3];
-    for (k, e) in edges.iter_mut().enumerate() {
-        let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-        let (a, b) = if (t.x[i], t.y[i]) < (t.x[j], t.y[j]) {
-            (i, j)
-        } else {
-            (j, i)
-        };
-        let (ax, ay, dx, dy) = (t.x[a], t.y[a], t.x[b] - t.x[a], t.y[b] - t.y[a]);
-        // The sign that makes the opposite vertex (the triangle's inside) non-negative.
-        let at_k = dx * (t.y[k] - ay) - dy * (t.x[k] - ax);
-        *e = (ax, ay, dx, dy, if at_k < 0.0 { -1.0 } else { 1.0 });
-    }
-    for sy in r0..=r1 {
-        let py = sy as f32 + 0.5;
-        let row_terms = edges.map(|(_, ay, dx, _, _)| dx * (py - ay));
-        let base = (sy - y0) * ws;
-        for sx in c0..=c1 {
-            let px = sx as f32 + 0.5;
-            let mut e = [0.0f32; 3];
-            for k in 0..3 {
-                let (ax, _, _, dy, sign) = edges[k];
-                e[k] = sign * (row_terms[k] - dy * (px - ax));
-            }
-            let sum = e[0] + e[1] + e[2];
-            if e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0 || sum <= 0.0 {
-                continue;
-            }
-            let b = [e[0] / sum, e[1] / sum, e[2] / sum];
-            let w = b[0] * t.w[0] + b[1] * t.w[1] + b[2] * t.w[2];
-            let i = base + sx;
-            if w > depth[i] {
-                depth[i] = w;
-                colour[i] = (b[0] * t.cw[0] + b[1] * t.cw[1] + b[2] * t.cw[2]) / w;
-            }
-        }
-    }
-}
-
-/// Tone mapping: linear radiosity × exposure, then the sRGB transfer curve, clamped to 8 bits.
-///
-/// `Some(e)` with `e` finite and ≥ 0 is used as given; otherwise the exposure is automatic: the
-/// 97th percentile of the luminance of the non-background (non-zero) pixels is mapped to linear
-/// 0.9, so a few very bright pixels (the lights) do not darken everything. An image without
-/// such pixels gets exposure 1. Returns the image and the exposure used.
-pub fn tone_map(img: &LinearImage, exposure: Option<f32>) -> (image::RgbImage, f32) {
-    let exposure = match exposure {
-        Some(e) if e.is_finite() && e >= 0.0 => e,
-        _ => auto_exposure(&img.pixels),
-    };
-    let (w, h) = (img.width as usize, img.height as usize);
-    let mut out = image::RgbImage::new(img.width, img.height);
-    if img.pixels.len() == w.saturating_mul(h) {
-        for (px, lin) in out.pixels_mut().zip(&img.pixels) {
-            px.0 = lin.map(|c| {
-                let v = c * exposure;
-                let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-                (srgb_encode(v) * 255.0).round() as u8
-            });
-        }
-    }
-    (out, exposure)
-}
-
-/// The exposure that maps the 97th luminance percentile of the lit pixels to 0.9 (1 if none).
-/// Also used for the 8-bit colours of exported meshes.
-pub fn auto_exposure(pixels: &[[f32; 3]]) -> f32 {
-    let mut lum: Vec<f32> = pixels
-        .iter()
-        .map(|p| 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2])
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .collect();
-    if lum.is_empty() {
-        return 1.0;
-    }
-    let k = ((lum.len() - 1) as f32 * 0.97).round() as usize;
-    let (_, p, _) = lum.select_nth_unstable_by(k, f32::total_cmp);
-    let e = 0.9 / *p;
-    if e.is_finite() && e > 0.0 {
-        e
+    let diag = (hi - lo).length();
+    if diag.is_finite() && diag > 0.0 {
+        (1e-5 * diag).max(1e-7)
     } else {
-        1.0
-    }
-}
-
-/// The sRGB transfer curve (IEC 61966-2-1) for v in [0, 1].
-pub fn srgb_encode(v: f32) -> f32 {
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
+        1e-4
     }
 }
 
