@@ -39,7 +39,6 @@ pub mod sample;
 pub mod saved;
 pub mod scene;
 pub mod settings;
-pub mod shot_bench;
 pub mod solve;
 
 pub use error::Error;

@@ -2,6 +2,8 @@
 //! thread count, for every method, the default `adaptive-hybrid` included (its switch from
 //! hemi-cubes to rays is decided from counted work, not from measured times).
 
+mod common;
+
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::{self, LoadOptions, Scene};
@@ -129,4 +131,30 @@ fn switch_at_replays_the_counted_switch_and_measured_is_kept() {
     assert!(!w.forced && w.by == SwitchBy::Measured, "{w:?}");
     assert!(w.ray_shot_seconds < w.hemicube_shot_seconds, "{w:?}");
     assert_eq!(w.shot, sol.stats.hemicube_shots);
+}
+
+/// The bar as a user meets it: two default `radiosity solve` runs of each scene in `scenes/`
+/// write identical `patches.csv` files, and so does a run on one thread.
+#[test]
+fn two_default_cli_solves_write_identical_patch_tables() {
+    let t = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["blocks", "office", "hallway", "church", "cornell-box"] {
+        let obj = root.join("scenes").join(format!("{name}.obj"));
+        let obj = obj.to_str().unwrap();
+        let table = |run: &str, extra: &[&str]| {
+            let out = t.path().join(format!("{name}-{run}"));
+            let mut args = vec!["solve", obj, "--quiet", "--out", out.to_str().unwrap()];
+            args.extend_from_slice(extra);
+            let (code, _, err) = common::run(&args);
+            assert_eq!(code, 0, "{name} {run}: {err}");
+            std::fs::read(out.join("patches.csv")).unwrap()
+        };
+        let a = table("a", &[]);
+        assert!(a == table("b", &[]), "{name}: two default solves differ");
+        assert!(
+            a == table("one-thread", &["--threads", "1"]),
+            "{name}: one thread differs from the default"
+        );
+    }
 }

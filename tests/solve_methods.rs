@@ -162,7 +162,7 @@ fn methods_report_what_they_did_and_do_not_depend_on_threads() {
     let scene = blocks();
     let m = mesh_at(&scene, None);
     for method in ALL {
-        // The hybrid's measured switch depends on timings: replay a fixed one.
+        // The hybrid's switch forced at a given shot (`--switch-at`), as a replay does.
         let cfg = SolveSettings {
             switch_at: (method == MethodKind::AdaptiveHybrid).then_some(4),
             ..config(method)
@@ -194,10 +194,10 @@ fn methods_report_what_they_did_and_do_not_depend_on_threads() {
     }
 }
 
-/// Left to its measurements, the hybrid switches when a shot by rays is predicted cheaper than
-/// by hemi-cube, and says so.
+/// Left to its cost model (counted work × the kept constants, the default), the hybrid switches
+/// when a shot by rays is predicted cheaper than by hemi-cube, and says so.
 #[test]
-fn the_hybrid_switches_on_measured_costs() {
+fn the_hybrid_switches_on_counted_costs() {
     let scene = blocks();
     let m = mesh_at(&scene, None);
     let sol = solve_mesh(&scene, &m, &config(MethodKind::AdaptiveHybrid));

@@ -11,4 +11,5 @@ pub mod crosscheck;
 pub mod intersect;
 pub mod intersect_table;
 pub mod rays;
+pub mod shots;
 pub mod sweep;

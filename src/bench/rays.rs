@@ -120,6 +120,7 @@ pub fn bench_rays(
     let cfg = &SolveSettings {
         method: solve::MethodKind::AdaptiveRays,
         switch_at: None,
+        switch_by: Default::default(),
         ..cfg.clone()
     };
     let model = Model::load(source, load, mesh_opts)?;

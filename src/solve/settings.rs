@@ -216,6 +216,12 @@ impl SolveSettings {
                 self.hemicube_n
             ));
         }
+        if self.switch_by != SwitchBy::Counted && self.method != MethodKind::AdaptiveHybrid {
+            return Invalid::err(format!(
+                "--switch-by applies to --method adaptive-hybrid only, not {}",
+                self.method.name()
+            ));
+        }
         if self.switch_at.is_some() && self.method != MethodKind::AdaptiveHybrid {
             return Invalid::err(format!(
                 "--switch-at applies to --method adaptive-hybrid only, not {}",

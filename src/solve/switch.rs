@@ -47,7 +47,7 @@ use std::time::Instant;
 /// job), 2026-11-30, by `radiosity bench shots scenes/S.obj --out bench-S.json`, twice for
 /// S = blocks, office, hallway, church and once for cornell-box, then fitted to the nine runs'
 /// timed shots together (their `cube_samples` and `ray_samples`, 6,912 hemi-cube and 1,728 ray
-/// shots; [`crate::shot_bench::pooled_fit`], the fit `bench shots` prints per scene). Seconds
+/// shots; [`crate::bench::shots::pooled_fit`], the fit `bench shots` prints per scene). Seconds
 /// per patch transformed into a hemi-cube's frame.
 pub const PATCH_SECONDS: f64 = 2.0e-8;
 /// Seconds per (patch, face) pair mapped onto a hemi-cube face and clipped to its frustum

@@ -12,7 +12,7 @@ use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
 use radiosity::solve::lights::GroupBy;
 use radiosity::solve::settings::{DEFAULT_GATHER_CAP_MIB, DEFAULT_HEMICUBE_N};
-use radiosity::solve::{MethodKind, SolveSettings};
+use radiosity::solve::{MethodKind, SolveSettings, SwitchBy};
 use std::path::PathBuf;
 
 /// How the scene is read and cut into patches.
@@ -121,6 +121,27 @@ pub struct SolverArgs {
     /// model says so (the switch shot a summary.json recorded).
     #[arg(long, value_name = "SHOT")]
     pub switch_at: Option<u64>,
+    /// adaptive-hybrid: decide the switch from counted work weighed by the kept cost constants
+    /// (reproducible on every run), or from times measured during the solve (adapts to the
+    /// machine; the result then varies from run to run).
+    #[arg(long, value_enum, default_value_t = SwitchByArg::Counted)]
+    pub switch_by: SwitchByArg,
+}
+
+/// `--switch-by`: see `radiosity::solve::SwitchBy`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum SwitchByArg {
+    Counted,
+    Measured,
+}
+
+impl From<SwitchByArg> for SwitchBy {
+    fn from(a: SwitchByArg) -> SwitchBy {
+        match a {
+            SwitchByArg::Counted => SwitchBy::Counted,
+            SwitchByArg::Measured => SwitchBy::Measured,
+        }
+    }
 }
 
 impl SolverArgs {
@@ -130,6 +151,7 @@ impl SolverArgs {
             max_time: self.max_time,
             max_rays: self.max_rays,
             switch_at: self.switch_at,
+            switch_by: self.switch_by.into(),
             ..self.sampling.over(SolveSettings::default())
         }
     }

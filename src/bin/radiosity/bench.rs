@@ -211,7 +211,7 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
                     "--resolutions must be between 2 and 4096, got {bad}"
                 )));
             }
-            let b = radiosity::shot_bench::bench_shots(
+            let b = radiosity::bench::shots::bench_shots(
                 &source(scene),
                 &scene_args.load(),
                 &scene_args.mesh(),
