@@ -12,7 +12,7 @@ pub mod report;
 
 use crate::export::patches::read_reference;
 use crate::export::{self, patches, write_atomic};
-use crate::intersect::select::IntersectorKind;
+use crate::intersect::select::{AnyIntersector, IntersectorKind};
 use crate::intersect::Intersector;
 use crate::mesh::MeshOptions;
 use crate::model::Model;
@@ -216,6 +216,44 @@ fn validate(job: &CompareJob) -> Result<(), Error> {
     Ok(())
 }
 
+/// One run of `method` within the budget, measured against the reference `b_ref`.
+fn run_method(
+    job: &CompareJob,
+    model: &Model,
+    isect: Option<&AnyIntersector>,
+    method: MethodKind,
+    b_ref: &Arc<Vec<[f64; 3]>>,
+) -> Result<MethodRun, Error> {
+    let cfg = SolveSettings {
+        method,
+        max_time: Some(job.budget),
+        switch_at: None,
+        switch_by: if method == MethodKind::AdaptiveHybrid {
+            job.solve.switch_by
+        } else {
+            Default::default()
+        },
+        ..job.solve.clone()
+    };
+    let hooks = solve::RunHooks {
+        reference: Some(b_ref.clone()),
+        ..Default::default()
+    };
+    let sol = model.solve(isect, &cfg, &hooks, |_| {})?;
+    let last = sol.stats.trace.last();
+    Ok(MethodRun {
+        method,
+        seconds: sol.stats.seconds,
+        shots: sol.stats.shots,
+        rays: sol.stats.rays,
+        cells: last.map_or(sol.stats.hemicube_cells, |p| p.cells),
+        stop_reason: sol.stats.stop_reason,
+        switch: sol.stats.switch,
+        error: last.and_then(|p| p.error),
+        trace: sol.stats.trace.clone(),
+    })
+}
+
 /// `radiosity compare`: runs every method on one mesh against one reference and writes
 /// `compare.csv`, `compare.md`, `compare.json` and the plots into `job.out`.
 pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Comparison, Error> {
@@ -229,10 +267,6 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
         m.patches.len(),
         m.patch_size
     ));
-    let fail = |source| Error::Solve {
-        scene: scene.name.clone(),
-        source,
-    };
     // One intersector for every method that casts rays, and for the reference.
     let needs_rays = job.reference.is_none() || job.methods.iter().any(|m| m.casts_rays());
     let isect = if needs_rays {
@@ -248,8 +282,12 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
                 "building the reference (adaptive rays, tolerance {}, stop {}) …",
                 job.reference_solve.tolerance, job.reference_solve.stop_fraction
             ));
-            let r =
-                reference::build(m, &scene.materials, isect, &job.reference_solve).map_err(fail)?;
+            let r = reference::build(m, &scene.materials, isect, &job.reference_solve).map_err(
+                |source| Error::Solve {
+                    scene: scene.name.clone(),
+                    source,
+                },
+            )?;
             log(&format!(
                 "reference in {:.1} s: {}",
                 t.elapsed().as_secs_f64(),
@@ -272,30 +310,7 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
     let mut all: Vec<Vec<MethodRun>> = job.methods.iter().map(|_| Vec::new()).collect();
     for round in 0..job.repeat.max(1) {
         for (k, &method) in job.methods.iter().enumerate() {
-            let cfg = SolveSettings {
-                method,
-                max_time: Some(job.budget),
-                switch_at: None,
-                ..job.solve.clone()
-            };
-            let hooks = solve::RunHooks {
-                reference: Some(b_ref.clone()),
-                ..Default::default()
-            };
-            let sol = solve::run(m, &scene.materials, isect.as_ref(), &cfg, &hooks, |_| {})
-                .map_err(fail)?;
-            let last = sol.stats.trace.last();
-            let run = MethodRun {
-                method,
-                seconds: sol.stats.seconds,
-                shots: sol.stats.shots,
-                rays: sol.stats.rays,
-                cells: last.map_or(sol.stats.hemicube_cells, |p| p.cells),
-                stop_reason: sol.stats.stop_reason,
-                switch: sol.stats.switch,
-                error: last.and_then(|p| p.error),
-                trace: sol.stats.trace.clone(),
-            };
+            let run = run_method(job, &model, isect.as_ref(), method, &b_ref)?;
             log(&format!(
                 "{}{}: {} shots, {} form factors in {:.2} s; error {:.2} % (average weighted percent)",
                 method.name(),
