@@ -87,11 +87,7 @@ pub struct SolutionMeta {
 }
 
 /// One light's share of the radiosity (for relighting): B per patch with only that light on.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LightChannel {
-    pub name: String,
-    pub b: Vec<[f64; 3]>,
-}
+pub use crate::solve::LightChannel;
 
 /// A solution as saved and loaded.
 #[derive(Clone, Debug, PartialEq)]

@@ -233,16 +233,8 @@ fn save_solution(
         settings: job.settings.to_json(),
     };
     let vertex_b = m.vertex_values(&sol.b);
-    let channels: Vec<solution::LightChannel> = sol
-        .channels
-        .iter()
-        .map(|c| solution::LightChannel {
-            name: c.name.clone(),
-            b: c.b.clone(),
-        })
-        .collect();
     write_atomic(path, |w| {
-        solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &channels)
+        solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &sol.channels)
     })?;
     Ok(())
 }

@@ -36,7 +36,7 @@ use super::ray_shots::{
 use super::stopping::{self, Progress};
 use super::switch::{self, CostModel, SwitchPolicy};
 use super::{
-    scalar, Channel, MethodKind, RunHooks, Solution, SolveError, SolveSettings, SolveStats,
+    scalar, LightChannel, MethodKind, RunHooks, Solution, SolveError, SolveSettings, SolveStats,
     StopReason, TracePoint,
 };
 use crate::intersect::Intersector;
@@ -506,7 +506,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
                 .channel_radiosity(self.mesh, self.materials, &g.of_patch)
                 .into_iter()
                 .zip(&g.names)
-                .map(|(b, name)| Channel {
+                .map(|(b, name)| LightChannel {
                     name: name.clone(),
                     b,
                 })

@@ -394,7 +394,7 @@ fn light_channels(
     rho: &[[f64; 3]],
     area: &[f64],
     stop_fraction: f64,
-) -> Vec<super::Channel> {
+) -> Vec<super::LightChannel> {
     g.names
         .iter()
         .enumerate()
@@ -404,7 +404,7 @@ fn light_channels(
                 .zip(&g.of_patch)
                 .map(|(e, &grp)| if grp as usize == c { *e } else { [0.0; 3] })
                 .collect();
-            super::Channel {
+            super::LightChannel {
                 name: name.clone(),
                 b: gauss_seidel(ff, &e_c, rho, area, stop_fraction, 100_000).0,
             }

@@ -179,12 +179,13 @@ pub struct Solution {
     pub stats: SolveStats,
     /// Per light group, the radiosity with only that light on (empty unless asked for); they
     /// sum to `b` (to rounding).
-    pub channels: Vec<Channel>,
+    pub channels: Vec<LightChannel>,
 }
 
-/// One light group's radiosity per patch (W/m², RGB).
+/// One light group's radiosity per patch (W/m², RGB): a *light* channel (`--per-light`), as
+/// opposed to the R, G, B colour channels every radiosity has.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Channel {
+pub struct LightChannel {
     pub name: String,
     pub b: Vec<[f64; 3]>,
 }

@@ -145,12 +145,12 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         for k in first..first + count {
             let dir = frame.to_world(shot.grid.direction(k, 0.0, self.jitter, &mut rng));
             let org = points.sample(&mut rng) + patch.normal * eps;
-            out.push(self.trace(i, org, dir, eps));
+            out.push(self.cast_one(i, org, dir, eps));
         }
         out
     }
 
-    fn trace(&self, shooter: usize, org: Vec3, dir: Vec3, eps: f32) -> u32 {
+    fn cast_one(&self, shooter: usize, org: Vec3, dir: Vec3, eps: f32) -> u32 {
         let mut ray = Ray {
             org,
             dir,
