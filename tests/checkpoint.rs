@@ -267,3 +267,35 @@ fn command_line_checkpoints_and_refusals() {
         "gathering",
     );
 }
+
+/// The checkpoint key is derived from every setting that shapes the result (issue 12): a
+/// setting added to the settings types reaches it without being listed. `--switch-by` (added
+/// after the key stopped being written by hand) is in it; the budgets are not, so a run may be
+/// resumed with more time.
+#[test]
+fn the_checkpoint_key_holds_every_shaping_setting_and_no_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).display().to_string();
+    let blocks = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/blocks.obj");
+    let blocks = blocks.to_str().unwrap();
+    let solve = |extra: &[&str], out: &str| {
+        let o = p(out);
+        let mut args = vec!["solve", blocks, "--quiet", "--out", o.as_str()];
+        args.extend_from_slice(extra);
+        common::run(&args)
+    };
+    let ckpt = p("h.ckpt");
+    let (code, _, err) = solve(&["--checkpoint", &ckpt], "a");
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = solve(&["--resume", &ckpt, "--switch-by", "measured"], "b");
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("another run"), "{err}");
+    let (code, _, err) = solve(&["--resume", &ckpt, "--max-time", "100"], "c");
+    assert_eq!(code, 0, "{err}");
+    // The summary records the same settings, derived from the same type.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(p("c/summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["settings"]["solve"]["switch_by"], "counted");
+    assert_eq!(summary["settings"]["solve"]["max_time"], 100.0);
+    assert_eq!(summary["settings"]["mesh"]["two_sided"], false);
+}

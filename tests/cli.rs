@@ -439,6 +439,10 @@ fn a_small_sweep_writes_its_table_and_plots() {
     let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
     assert!(!csv.contains("NaN"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("sweep.json")).unwrap()).unwrap();
+    assert_eq!(json["settings"]["tolerance"], 0.2);
+    assert_eq!(json["rows"].as_array().unwrap().len(), 2);
     for png in ["time.png", "memory.png"] {
         let img = image::open(out.join(png)).unwrap();
         assert!(img.width() > 100);

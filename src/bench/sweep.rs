@@ -4,7 +4,8 @@
 //! load, mesh, intersector build and solve time; shots, rays, rays per second; peak memory (the
 //! resident set's high-water mark, read from the OS, reset before each run) and the memory the
 //! Embree scene took (resident set before and after building it); the solver's own error
-//! estimate. Writes `sweep.csv`, `sweep.md` (table and fitted growth exponents) and log–log
+//! estimate. Writes `sweep.csv`, `sweep.json` (the rows with every setting), `sweep.md` (table
+//! and fitted growth exponents) and log–log
 //! plots `time.png` and `memory.png`.
 //!
 //! Each building is written to a file and loaded from it, as a user would; the file is removed
@@ -319,6 +320,17 @@ fn write_outputs(job: &SweepJob, rows: &[SweepRow]) -> Result<(), Error> {
     })?;
     let md = markdown(rows, &job.methods);
     write_atomic(&job.out.join("sweep.md"), |w| w.write_all(md.as_bytes()))?;
+    // The rows with every setting they were run with (derived from the settings type).
+    let json = serde_json::json!({
+        "settings": job.cfg,
+        "intersector": job.intersector,
+        "building_seed": job.seed,
+        "rows": rows,
+    });
+    write_atomic(&job.out.join("sweep.json"), |w| {
+        serde_json::to_writer_pretty(&mut *w, &json).map_err(std::io::Error::other)?;
+        writeln!(w)
+    })?;
     let curves = |f: &dyn Fn(&SweepRow) -> f64| -> Vec<Curve> {
         job.methods
             .iter()
