@@ -17,7 +17,7 @@
 //!
 //! Around it: [`settings`] (the settings types and their one error), [`pipeline`] (what
 //! `radiosity solve` and `info` do), [`saved`] (commands on a saved solution: render, export,
-//! relight), [`compare`] (reference and methods side by side), [`bench`] (benchmarks,
+//! relight), [`compare`] (reference and methods side by side), [`bench`](mod@bench) (benchmarks,
 //! cross-checks and the scene-size sweep), [`render`] (rasteriser, false colour, glyphs),
 //! [`export`] (file formats), [`report`] (summaries, traces, plots), [`generate`] (generated
 //! buildings). The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.

@@ -4,7 +4,7 @@
 //!
 //! - [`reference`](mod@reference): the high-accuracy reference, its stated error bound and the check of it;
 //! - [`analysis`]: time to reach an error level, the decay constant E, cost per shot;
-//! - [`report`]: `compare.csv` and `compare.md`; [`plot`]: the PNG plots.
+//! - [`report`]: `compare.csv` and `compare.md`; its `plots` the PNG plots.
 
 pub mod analysis;
 pub mod reference;

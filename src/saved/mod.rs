@@ -1,6 +1,6 @@
 //! The commands that act on a saved solution ([`crate::export::solution`]), without the OBJ and
-//! without solving again: [`render`] (`radiosity render`: an image), [`export`] (`radiosity
-//! export`: a mesh) and [`relight`] (`radiosity relight`: the lights re-weighted, then either).
+//! without solving again: [`render`](mod@render) (`radiosity render`: an image), [`export`](mod@export) (`radiosity
+//! export`: a mesh) and [`relight`](mod@relight) (`radiosity relight`: the lights re-weighted, then either).
 //! The format follows the extension of `--out` (docs/design.md §5).
 //!
 //! Given the scene too (`--scene`), the solution is checked against it first and refused when

@@ -5,8 +5,8 @@
 //! go through the equal-area polar cells of [`PolarGrid`] (the unit circle split into X pieces
 //! of form factor 1/X each, twice as many θ divisions as radial ones, radii at √k), turned by a
 //! random angle about the normal (Sec. 3: the random rotation of Cohen et al.), from points
-//! spread uniformly over the patch ([`PatchPoints`]). The patch `j` a ray hits first receives
-//! ρ_j·ΔΦ_i/X; the rest is absorbed ([`apply_rays`]).
+//! spread uniformly over the patch (`PatchPoints`). The patch `j` a ray hits first receives
+//! ρ_j·ΔΦ_i/X; the rest is absorbed (`apply_rays`).
 //!
 //! Rays are cast in chunks of [`CHUNK`], the unit of parallel work; every chunk's random
 //! numbers come from (seed, shot, chunk), so what a ray hits never depends on which thread cast

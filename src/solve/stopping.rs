@@ -3,7 +3,7 @@
 //! "The refinement halted … at which point the maximum unshot radiosity was less than 0.06
 //! percent of the mean radiosity value. Nothing further can be shown on a 24 bit frame
 //! buffer." Here the unshot radiosity is weighed by what it will still add, all bounces
-//! counted ([`super::books::State::amplification`]): in a stiff scene (ρ near 1) unshot light
+//! counted (`State::amplification` in `books`): in a stiff scene (ρ near 1) unshot light
 //! is worth many times itself. Then the budgets (`max_time`, the one clock-dependent setting;
 //! `max_rays`, counted samples) and the interrupt flag, which is read only at safe points so a
 //! resumed run repeats the same shots.
@@ -17,7 +17,7 @@ pub(super) struct Progress {
     pub interrupted: bool,
     /// Max unshot radiosity (scalar, W/m²), over the patches above the stop threshold.
     pub max_unshot_b: f64,
-    /// What a unit of unshot radiosity will still add ([`super::books::State::amplification`]).
+    /// What a unit of unshot radiosity will still add (`State::amplification` in `books`).
     pub amplification: f64,
     /// Area-weighted mean radiosity (scalar, W/m²).
     pub mean_b: f64,

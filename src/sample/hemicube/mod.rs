@@ -132,8 +132,8 @@ impl Hemicube {
     /// Back faces are drawn too (they occlude); the caller learns they were seen from behind.
     ///
     /// The steps: size and clear the buffers; draw the jittered sample points; per patch, into
-    /// the frame ([`to_frame`]) and onto the faces ([`Hemicube::draw_patch`]); read the cells
-    /// back ([`Hemicube::read_back`]).
+    /// the frame (`to_frame`) and onto the faces (`Hemicube::draw_patch`); read the cells
+    /// back (`Hemicube::read_back`).
     #[allow(clippy::too_many_arguments)]
     pub fn shoot<R: Rng>(
         &self,
