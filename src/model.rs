@@ -39,6 +39,16 @@ impl Model {
         Ok(Model { scene, mesh })
     }
 
+    /// One line: the scene's name, its patch count and the patch size.
+    pub fn describe(&self) -> String {
+        format!(
+            "{}: {} patches at {} m",
+            self.scene.name,
+            self.mesh.patches.len(),
+            self.mesh.patch_size
+        )
+    }
+
     /// Builds the intersector of `kind` (resolving `auto` for this mesh), and says why.
     pub fn intersector(&self, kind: IntersectorKind) -> Result<(AnyIntersector, Selection), Error> {
         Ok(select::select(&self.mesh, kind)?)

@@ -59,12 +59,7 @@ pub fn run_reference(job: &ReferenceJob, mut log: impl FnMut(&str)) -> Result<Re
     export::prepare_dir(&job.out)?;
     let model = Model::load(&job.source, &job.load, &job.mesh)?;
     let (scene, m) = (&model.scene, &model.mesh);
-    log(&format!(
-        "{}: {} patches at {} m",
-        scene.name,
-        m.patches.len(),
-        m.patch_size
-    ));
+    log(&model.describe());
     let (isect, _) = model.intersector(job.intersector)?;
     let r = reference::build(m, &scene.materials, &isect, &job.solve).map_err(|source| {
         Error::Solve {
@@ -261,12 +256,7 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
     export::prepare_dir(&job.out)?;
     let model = Model::load(&job.source, &job.load, &job.mesh)?;
     let (scene, m) = (&model.scene, &model.mesh);
-    log(&format!(
-        "{}: {} patches at {} m",
-        scene.name,
-        m.patches.len(),
-        m.patch_size
-    ));
+    log(&model.describe());
     // One intersector for every method that casts rays, and for the reference.
     let needs_rays = job.reference.is_none() || job.methods.iter().any(|m| m.casts_rays());
     let isect = if needs_rays {
