@@ -117,12 +117,7 @@ pub fn bench_rays(
         )));
     }
     // The solver's rays are what is measured: the ray shooter, whatever --method says.
-    let cfg = &SolveSettings {
-        method: solve::MethodKind::AdaptiveRays,
-        switch_at: None,
-        switch_by: Default::default(),
-        ..cfg.clone()
-    };
+    let cfg = &cfg.for_method(solve::MethodKind::AdaptiveRays);
     let model = Model::load(source, load, mesh_opts)?;
     let (scene, m) = (&model.scene, &model.mesh);
     let (isect, chosen) = model.intersector(kind)?;

@@ -194,18 +194,7 @@ fn run_one(
     };
     let build_s = t.elapsed().as_secs_f64();
     let (after, _) = rss_kib();
-    // The hybrid's switch settings apply to the hybrid runs only.
-    let hybrid = method == MethodKind::AdaptiveHybrid;
-    let cfg = SolveSettings {
-        method,
-        switch_at: job.cfg.switch_at.filter(|_| hybrid),
-        switch_by: if hybrid {
-            job.cfg.switch_by
-        } else {
-            Default::default()
-        },
-        ..job.cfg.clone()
-    };
+    let cfg = job.cfg.for_method(method);
     let sol = model.solve(isect.as_ref(), &cfg, &Default::default(), |_| {})?;
     let (_, peak) = rss_kib();
     let embree = (after - before).max(0.0);

@@ -220,15 +220,9 @@ fn run_method(
     b_ref: &Arc<Vec<[f64; 3]>>,
 ) -> Result<MethodRun, Error> {
     let cfg = SolveSettings {
-        method,
         max_time: Some(job.budget),
         switch_at: None,
-        switch_by: if method == MethodKind::AdaptiveHybrid {
-            job.solve.switch_by
-        } else {
-            Default::default()
-        },
-        ..job.solve.clone()
+        ..job.solve.for_method(method)
     };
     let hooks = solve::RunHooks {
         reference: Some(b_ref.clone()),

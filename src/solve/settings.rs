@@ -177,6 +177,24 @@ impl SolveSettings {
         }
     }
 
+    /// These settings for `method` instead: the settings that apply to one method only (the
+    /// hybrid's `switch_at` and `switch_by`) fall back to their defaults for the others. For
+    /// the commands that run several methods with one set of flags (`compare`, `sweep`, the
+    /// benchmarks).
+    pub fn for_method(&self, method: MethodKind) -> SolveSettings {
+        let hybrid = method == MethodKind::AdaptiveHybrid;
+        SolveSettings {
+            method,
+            switch_at: self.switch_at.filter(|_| hybrid),
+            switch_by: if hybrid {
+                self.switch_by
+            } else {
+                SwitchBy::default()
+            },
+            ..self.clone()
+        }
+    }
+
     /// Checks the settings a user can get wrong (one line naming the flag), before any work.
     /// Every command that solves calls this, so each refuses what `solve` refuses, in the same
     /// words.
