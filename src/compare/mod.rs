@@ -47,6 +47,9 @@ struct ReferenceSummary<'a> {
     patch_size: f32,
     method: &'static str,
     intersector: &'static str,
+    /// The reference's settings as given (each half runs at √2 × the tolerance), derived
+    /// from the settings type.
+    settings: &'a SolveSettings,
     #[serde(flatten)]
     reference: &'a Reference,
 }
@@ -77,6 +80,7 @@ pub fn run_reference(job: &ReferenceJob, mut log: impl FnMut(&str)) -> Result<Re
         patch_size: m.patch_size,
         method: MethodKind::AdaptiveRays.name(),
         intersector: isect.name(),
+        settings: &job.solve,
         reference: &r,
     };
     write_atomic(&job.out.join("summary.json"), |w| {
