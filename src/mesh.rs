@@ -545,6 +545,7 @@ mod tests {
                 name: "m".into(),
                 rho: [0.5; 3],
                 ke: [0.0; 3],
+                ..Material::default()
             }],
             ..Scene::default()
         };

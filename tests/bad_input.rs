@@ -1,6 +1,8 @@
 //! Issue 8, "Bad input": every malformed file in `tests/corpus/` and every bad flag value or
 //! combination gives exactly one error line naming the problem, exit code 2, no panic, and
-//! leaves no output behind (no file, no temporary file, no new folder).
+//! leaves no output behind (no file, no temporary file, no new folder); the odd but valid
+//! files (`odd-*`: comments after the data, continued lines, Kd of 1 or more, textures) load
+//! and solve with exactly the warnings they deserve.
 //!
 //! The table below is the corpus index: one row per case, `{c}` standing for `tests/corpus`,
 //! `{s}` for a shared folder holding a solved solution (`{s}/sol.rad`, `{s}/o/patches.csv`),
@@ -51,9 +53,9 @@ const FILES: &[Case] = &[
     ("usemtl of an undefined material, so no light", "solve -q {c}/usemtl-undefined-material.obj --out {t}/o", &["usemtl-undefined-material.obj", "no light", "--emit"]),
     ("mtllib escaping with ../ to nothing", "solve -q {c}/mtllib-escapes-with-dotdot.obj --out {t}/o", &["mtllib-escapes-with-dotdot.obj", "no light"]),
     ("mtllib is a folder", "solve -q {c}/mtllib-is-a-folder.obj --out {t}/o", &["mtllib-is-a-folder.obj", "material library '.'", "cannot read"]),
-    ("Kd above 1", "solve -q {c}/mtl-kd-above-one.obj --out {t}/o", &["mtl-kd-above-one.obj", "'white'", "Kd 1.5", "outside [0, 1)"]),
-    ("Kd negative", "solve -q {c}/mtl-kd-negative.obj --out {t}/o", &["mtl-kd-negative.obj", "'white'", "-0.2", "outside [0, 1)"]),
-    ("Kd NaN", "solve -q {c}/mtl-kd-nan.obj --out {t}/o", &["mtl-kd-nan.obj", "'white'", "NaN", "outside [0, 1)"]),
+    // Kd of 1 or more is clamped with a warning (see ODD); below 0 or not finite, an error.
+    ("Kd negative", "solve -q {c}/mtl-kd-negative.obj --out {t}/o", &["mtl-kd-negative.obj", "'white'", "-0.2", "not a reflectance"]),
+    ("Kd NaN", "solve -q {c}/mtl-kd-nan.obj --out {t}/o", &["mtl-kd-nan.obj", "'white'", "NaN", "not a reflectance"]),
     ("Kd of 2 numbers", "solve -q {c}/mtl-kd-two-numbers.obj --out {t}/o", &["mtl-kd-two-numbers.obj", "mtl-kd-two-numbers.mtl", "line 2", "needs 3 numbers"]),
     ("Kd not a number", "solve -q {c}/mtl-kd-not-a-number.obj --out {t}/o", &["mtl-kd-not-a-number.mtl", "line 2", "'grey' is not a number"]),
     ("Kd spectral", "solve -q {c}/mtl-kd-spectral.obj --out {t}/o", &["mtl-kd-spectral.mtl", "line 2", "not supported"]),
@@ -62,6 +64,9 @@ const FILES: &[Case] = &[
     ("Ke inf", "solve -q {c}/mtl-ke-inf.obj --out {t}/o", &["mtl-ke-inf.obj", "'white'", "inf", "finite"]),
     ("Ns not a number", "solve -q {c}/mtl-ns-not-a-number.obj --out {t}/o", &["mtl-ns-not-a-number.mtl", "line 3", "Ns shiny"]),
     ("non-UTF-8 bytes in the MTL", "solve -q {c}/mtl-non-utf8.obj --out {t}/o", &["mtl-non-utf8.mtl", "line 2", "not a number"]),
+    // Continued lines and comments after the data: messages name the file's own lines.
+    ("bad index after continued lines", "solve -q {c}/continued-lines-then-bad-index.obj --out {t}/o", &["continued-lines-then-bad-index.obj", "line 13", "vertex 99", "has 6 vertices"]),
+    ("face of 2 vertices and a comment", "solve -q {c}/trailing-comment-then-bad-face.obj --out {t}/o", &["trailing-comment-then-bad-face.obj", "line 4", "a face with 2 vertices"]),
     ("info reads the same way", "info {c}/face-index-zero.obj", &["face-index-zero.obj", "index 0"]),
     // Generated here rather than committed (the repository stays small).
     ("an extremely long line", "solve -q {s}/long-line.obj --out {t}/o", &["long-line.obj", "vertex 3 (line 3)", "not finite"]),
@@ -119,13 +124,27 @@ const FLAGS: &[Case] = &[
     ("render under a regular file", "render {s}/sol.rad --out {s}/regular/x.png", &["x.png", "is a file, not a folder"]),
     ("render --width 0", "render {s}/sol.rad --out {t}/x.png --width 0", &["--width"]),
     ("render --false-colour to HDR", "render {s}/sol.rad --out {t}/x.hdr --false-colour", &["--false-colour", ".png"]),
-    ("render checked against another scene", "render {s}/sol.rad --scene {c}/mtl-kd-above-one.obj --out {t}/x.png", &["mtl-kd-above-one.obj", "outside [0, 1)"]),
+    ("render checked against another scene", "render {s}/sol.rad --scene {c}/mtl-kd-negative.obj --out {t}/x.png", &["mtl-kd-negative.obj", "not a reflectance"]),
     ("export of a file that is not a solution", "export {c}/not-a-solution.rad --out {t}/x.ply", &["not-a-solution.rad", "not a radiosity solution"]),
     ("export to an unknown format", "export {s}/sol.rad --out {t}/x.stl", &["x.stl", ".ply or .glb"]),
     ("relight with a negative weight", "relight {s}/sol.rad --out {t}/x.png --weight lamp=-1", &["--weight", "finite number"]),
     ("relight with a NaN weight", "relight {s}/sol.rad --out {t}/x.png --weight lamp=nan", &["--weight", "finite number"]),
     ("relight with a weight without =", "relight {s}/sol.rad --out {t}/x.png --weight lamp", &["--weight", "LIGHT=WEIGHT"]),
     ("relight of an unknown light", "relight {s}/sol.rad --out {t}/x.png --weight nosuch=2", &["nosuch", "no such light", "lamp"]),
+];
+
+/// (what is odd, the command line, words the warnings must hold: none means no warning).
+type OddCase = (&'static str, &'static str, &'static [&'static str]);
+
+/// Odd but valid input: each loads and solves (exit code 0, `summary.json` written), with
+/// exactly the warnings named (in the summary's `warnings`).
+#[rustfmt::skip]
+const ODD: &[OddCase] = &[
+    ("comments after the data in the OBJ and the MTL", "solve -q {c}/odd-trailing-comments.obj --out {t}/o", &[]),
+    ("backslash line continuations", "solve -q {c}/odd-line-continuation.obj --out {t}/o", &[]),
+    ("Kd above 1 is clamped", "solve -q {c}/odd-kd-above-one.obj --out {t}/o", &["clamped to 0.98", "'white'"]),
+    ("Kd 1 1 1 with a texture, and with a missing one", "solve -q {c}/odd-kd-one-with-texture.obj --out {t}/o",
+        &["1 texture(s) not loaded", "'lamp'", "lamp-texture-that-is-not-there.png: no such file", "clamped to 0.98 (a closed room"]),
 ];
 
 fn corpus() -> &'static Path {
@@ -243,10 +262,61 @@ fn bad_flags_give_one_error_line_and_exit_2() {
 }
 
 #[test]
+fn odd_but_valid_input_loads_and_solves() {
+    let failures: Vec<String> = ODD
+        .iter()
+        .filter_map(|(what, line, needles)| {
+            let t = tempfile::tempdir().unwrap();
+            let args: Vec<String> = line
+                .split_whitespace()
+                .map(|w| {
+                    w.replace("{c}", &corpus().display().to_string())
+                        .replace("{t}", &t.path().display().to_string())
+                })
+                .collect();
+            let out = Command::cargo_bin("radiosity")
+                .unwrap()
+                .args(&args)
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            if !out.status.success() {
+                return Some(format!(
+                    "{what} (`{line}`): {:?}; stderr: {err}",
+                    out.status
+                ));
+            }
+            let Ok(summary) = std::fs::read_to_string(t.path().join("o/summary.json")) else {
+                return Some(format!("{what}: no summary.json written"));
+            };
+            let json: serde_json::Value = serde_json::from_str(&summary).unwrap();
+            let warnings: Vec<&str> = json["warnings"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|w| w.as_str().unwrap())
+                .collect();
+            let all = warnings.join("\n");
+            if needles.is_empty() && !warnings.is_empty() {
+                return Some(format!("{what}: unexpected warnings {warnings:?}"));
+            }
+            needles
+                .iter()
+                .find(|n| !all.contains(*n))
+                .map(|n| format!("{what}: '{n}' is in no warning: {warnings:?}"))
+        })
+        .collect();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
 fn every_corpus_file_is_used() {
-    let used: String = FILES.iter().chain(FLAGS).map(|c| c.1).collect();
+    let used: String = FILES.iter().chain(FLAGS).chain(ODD).map(|c| c.1).collect();
     for name in listing(corpus()) {
-        let stem = name.trim_end_matches(".mtl").trim_end_matches(".obj");
+        let stem = name
+            .trim_end_matches(".png")
+            .trim_end_matches(".mtl")
+            .trim_end_matches(".obj");
         assert!(used.contains(stem), "{name} is in no case");
     }
     assert!(FILES.len() >= 30, "the corpus has {} cases", FILES.len());

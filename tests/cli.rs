@@ -147,15 +147,43 @@ fn zero_area_faces_are_dropped_with_one_warning() {
 }
 
 #[test]
-fn reflectance_outside_zero_one() {
+fn negative_reflectance_is_an_error() {
     let d = tempfile::tempdir().unwrap();
     write(
         d.path(),
         "m.mtl",
-        &LIT_MTL.replace("Kd 0.5 0.5 0.5\nnewmtl", "Kd 1.2 0.5 0.5\nnewmtl"),
+        &LIT_MTL.replace("Kd 0.5 0.5 0.5\nnewmtl", "Kd -0.2 0.5 0.5\nnewmtl"),
     );
     let f = write(d.path(), "rho.obj", LIT_OBJ);
-    assert_user_error(&["info", &f], &["white"]);
+    assert_user_error(&["info", &f], &["white", "-0.2"]);
+}
+
+#[test]
+fn info_shows_where_each_reflectance_came_from() {
+    let d = tempfile::tempdir().unwrap();
+    let mtl = LIT_MTL.replace("Kd 0.5 0.5 0.5\nnewmtl", "Kd 1.2 0.5 0.5\nnewmtl");
+    write(d.path(), "m.mtl", &mtl);
+    let f = write(d.path(), "rho.obj", LIT_OBJ);
+    let (code, stdout, err) = run(&["info", &f]);
+    assert_eq!(code, 0, "{err}");
+    for needle in [
+        "rho 0.980 0.500 0.500",
+        "rho from Kd = 1.200 0.500 0.500, clamped to 0.98",
+        "rho from Kd\n",
+        "warning: ",
+        "'white'",
+    ] {
+        assert!(stdout.contains(needle), "{needle:?} missing from {stdout}");
+    }
+    let (code, stdout, err) = run(&["info", "--json", &f]);
+    assert_eq!(code, 0, "{err}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let white = &json["materials"][0];
+    assert_eq!(white["name"], "white");
+    assert_eq!(white["rho_source"]["kind"], "clamped");
+    assert_eq!(white["rho_source"]["from"]["kind"], "kd");
+    assert_eq!(white["rho_source"]["unclamped"][0], 1.2);
+    assert_eq!(json["materials"][1]["rho_source"]["kind"], "kd");
 }
 
 #[test]

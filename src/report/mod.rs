@@ -7,7 +7,7 @@ pub mod trace;
 
 use crate::intersect::select;
 use crate::mesh::{Mesh, PatchClass};
-use crate::scene::Scene;
+use crate::scene::{RhoSource, Scene};
 use crate::solve::estimate::ErrorMetrics;
 use crate::solve::{scalar, EnergyBalance, SolveStats, StopReason, SwitchInfo, TracePoint};
 use serde::Serialize;
@@ -28,6 +28,9 @@ pub struct LightInfo {
 pub struct MaterialInfo {
     pub name: String,
     pub rho: [f64; 3],
+    /// Where `rho` came from: `Kd`, `Kd` × a texture's mean colour, clamped, … (in JSON, an
+    /// object whose `kind` says which).
+    pub rho_source: RhoSource,
     pub ke: [f64; 3],
     pub polygons: usize,
 }
@@ -116,6 +119,7 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
             .map(|(m, &polygons)| MaterialInfo {
                 name: m.name.clone(),
                 rho: m.rho,
+                rho_source: m.rho_source.clone(),
                 ke: m.ke,
                 polygons,
             })
@@ -156,6 +160,7 @@ impl std::fmt::Display for SceneInfo {
                 "  {:<20} rho {:.3} {:.3} {:.3}  Ke {} {} {}  ({} polygons)",
                 m.name, m.rho[0], m.rho[1], m.rho[2], m.ke[0], m.ke[1], m.ke[2], m.polygons
             )?;
+            writeln!(f, "  {:<20} rho from {}", "", m.rho_source)?;
         }
         writeln!(f, "lights         {}", self.lights.len())?;
         for l in &self.lights {

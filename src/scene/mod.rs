@@ -41,14 +41,73 @@ impl SceneSource {
     }
 }
 
+/// The largest reflectance a material is given: an MTL `Kd` (or `Kd` × texture) of 1 or more
+/// in a channel is clamped to this, with a warning. Below 1 because a closed room whose
+/// surfaces all reflect everything (ρ = 1) never converges: no light is ever absorbed, so the
+/// unshot energy never falls.
+pub const MAX_REFLECTANCE: f64 = 0.98;
+
 /// A diffuse material: reflectance ρ per RGB channel and emitted radiance `Ke`.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Material {
     pub name: String,
-    /// Diffuse reflectance ρ (MTL `Kd`), each channel in [0, 1).
+    /// Diffuse reflectance ρ, each channel in [0, 1): MTL `Kd`, times the mean colour of its
+    /// `map_Kd` texture where that loads, at most [`MAX_REFLECTANCE`] where that was 1 or more.
     pub rho: [f64; 3],
     /// Emitted radiance (MTL `Ke` or `--emit`), W/sr/m².
     pub ke: [f64; 3],
+    /// Where [`Material::rho`] came from (shown by `radiosity info`).
+    pub rho_source: RhoSource,
+}
+
+/// Where a material's reflectance ρ came from.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum RhoSource {
+    /// MTL `Kd` (or given directly, as by a program that builds its scene).
+    #[default]
+    Kd,
+    /// No `Kd`: the default grey.
+    Default,
+    /// MTL `Kd` (1 1 1 when the material has none) times `mean`, the mean colour in linear
+    /// light of the `map_Kd` texture `file`.
+    KdTimesTexture {
+        file: String,
+        kd: [f64; 3],
+        mean: [f64; 3],
+    },
+    /// `fallback` alone (`Kd`, or the default grey): the `map_Kd` texture `file` did not
+    /// load (a warning says why).
+    TextureNotLoaded {
+        file: String,
+        fallback: Box<RhoSource>,
+    },
+    /// `from` gave `unclamped`, 1 or more in a channel; those channels are [`MAX_REFLECTANCE`].
+    Clamped {
+        unclamped: [f64; 3],
+        from: Box<RhoSource>,
+    },
+}
+
+impl std::fmt::Display for RhoSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let rgb = |v: &[f64; 3]| format!("{:.3} {:.3} {:.3}", v[0], v[1], v[2]);
+        match self {
+            RhoSource::Kd => write!(f, "Kd"),
+            RhoSource::Default => write!(f, "default grey (no Kd)"),
+            RhoSource::KdTimesTexture { file, kd, mean } => {
+                write!(f, "Kd {} × mean of texture '{file}' {}", rgb(kd), rgb(mean))
+            }
+            RhoSource::TextureNotLoaded { file, fallback } => {
+                write!(f, "{fallback} (texture '{file}' not loaded)")
+            }
+            RhoSource::Clamped { unclamped, from } => write!(
+                f,
+                "{from} = {}, clamped to {MAX_REFLECTANCE}",
+                rgb(unclamped)
+            ),
+        }
+    }
 }
 
 impl Material {

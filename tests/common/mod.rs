@@ -22,6 +22,7 @@ pub fn material(name: &str, rho: f64, ke: f64) -> Material {
         name: name.into(),
         rho: [rho; 3],
         ke: [ke; 3],
+        ..Material::default()
     }
 }
 

@@ -1,8 +1,11 @@
 //! OBJ + MTL loading through `tobj`: the only code in the crate that knows `tobj`.
 //!
 //! Polygons stay polygons (no triangulation: quads stay quads) and every model of the file is
-//! appended to the flat arrays of [`Scene`]. MTL `Kd` becomes the reflectance ρ, MTL `Ke` the
-//! emitted radiance (W/sr/m², docs/design.md §1), and [`LoadOptions::emit`] overrides `Ke` by name.
+//! appended to the flat arrays of [`Scene`]. MTL `Kd` × the mean colour of its `map_Kd` texture
+//! (where that loads; linear light) becomes the reflectance ρ, clamped to
+//! [`MAX_REFLECTANCE`](crate::scene::MAX_REFLECTANCE) where it is 1 or more (both with a
+//! warning); MTL `Ke` becomes the emitted radiance (W/sr/m², docs/design.md §1), and
+//! [`LoadOptions::emit`] overrides `Ke` by name.
 //! Faces of zero area are dropped with one warning; anything else wrong with the input is a
 //! [`SceneError`] whose message is one line naming the file — never a panic.
 //!
@@ -13,7 +16,11 @@
 //!   are checked first (a single number means grey, as the MTL specification allows);
 //! - tobj reports a missing material library only when no library loaded at all, so the
 //!   material loader here records what became of each library itself;
-//! - tobj's errors carry no line number: on failure a small scan finds the offending line.
+//! - tobj's errors carry no line number: on failure a small scan finds the offending line;
+//! - tobj reads neither a `#` comment after the data (`v 0 0 0 # note` becomes a vertex colour,
+//!   `usemtl wall # x` a material of that name) nor a backslash line continuation: both OBJ and
+//!   MTL texts are rewritten first, each line kept at its number so messages name the file's
+//!   lines.
 //!
 //! `Ke` arrives in `tobj::Material::emissive` (not in `unknown_param`; that is read as a fallback).
 
@@ -21,16 +28,17 @@ mod mtl;
 #[cfg(test)]
 mod tests;
 mod text;
+mod texture;
 
 use super::{Material, Polygon, Scene};
 use glam::Vec3;
-use mtl::{convert_material, default_grey, load_library, MtlLog, MtlSource};
+use mtl::{convert_material, default_grey, load_library, textures_and_clamp, MtlLog, MtlSource};
 use std::cell::RefCell;
 use std::collections::HashSet;
 use std::path::Path;
 use text::{
-    describe_non_finite, describe_obj_error, fmt3, io_reason, name_list, one_line, patch_size_hint,
-    prescan, without_lines,
+    describe_non_finite, describe_obj_error, fmt3, io_reason, name_list, normalize, one_line,
+    patch_size_hint, prescan, without_lines,
 };
 
 /// Options for loading a scene.
@@ -95,6 +103,9 @@ pub fn load_obj_from_strs(
 fn load(name: &str, text: &str, mtl: MtlSource, opts: &LoadOptions) -> Result<Scene, SceneError> {
     let fail = |message: String| SceneError::new(name, message);
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Comments after the data and continued lines, rewritten with the line numbers kept.
+    let normalized = normalize(text);
+    let text: &str = &normalized;
 
     // What tobj would drop silently, and the material names the faces ask for.
     let requested = prescan(text).map_err(fail)?;
@@ -175,10 +186,11 @@ fn scene_materials(
             "{name}: material library '{lib}' not found; using a default grey"
         ));
     }
-    let materials = tobj_materials
+    let mut materials = tobj_materials
         .iter()
         .map(convert_material)
         .collect::<Result<Vec<_>, _>>()?;
+    textures_and_clamp(name, tobj_materials, &mut materials, warnings);
     if parsed.missing.is_empty() {
         let mut unknown: Vec<&str> = requested
             .iter()

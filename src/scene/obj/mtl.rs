@@ -1,10 +1,11 @@
 //! The MTL side of loading: tobj's material loader (libraries from files or a given text,
 //! what became of each logged by name), the colour-line check that keeps tobj from panicking,
-//! and the conversion of tobj's materials (`Kd` → ρ, `Ke` → emitted radiance).
+//! and the conversion of tobj's materials (`Kd` × `map_Kd` → ρ, `Ke` → emitted radiance).
 
-use super::text::{fmt3, io_reason, snippet};
-use crate::scene::Material;
-use std::path::Path;
+use super::text::{fmt3, io_reason, normalize, snippet};
+use super::texture::{map_file, mean_colours, resolve};
+use crate::scene::{Material, RhoSource, MAX_REFLECTANCE};
+use std::path::{Path, PathBuf};
 
 /// Reflectance of a material without `Kd`, and of the material given to faces without one.
 const DEFAULT_GREY: f64 = 0.5;
@@ -28,21 +29,26 @@ pub(super) struct MtlLog {
     text_used: bool,
 }
 
-/// A scene material from a tobj material, checking `Kd` and `Ke`.
+/// The key under which a material read from a file carries its MTL's folder in
+/// `tobj::Material::unknown_param` (an MTL keyword has no space, so no file can set it).
+const FOLDER_KEY: &str = "radiosity mtl folder";
+
+/// A scene material from a tobj material, checking `Kd` and `Ke`: ρ is `Kd` as written (the
+/// texture and the clamp to [`MAX_REFLECTANCE`] come after, in [`textures_and_clamp`]).
 pub(super) fn convert_material(m: &tobj::Material) -> Result<Material, String> {
-    let rho = match m.diffuse {
+    let (rho, rho_source) = match m.diffuse {
         Some(kd) => {
             let rho = kd.map(to_f64);
-            if rho.iter().any(|r| !(0.0..1.0).contains(r)) {
+            if rho.iter().any(|r| !r.is_finite() || *r < 0.0) {
                 return Err(format!(
-                    "material '{}': Kd {} {} {} is outside [0, 1) (a reflectance must be at \
-                     least 0 and below 1)",
+                    "material '{}': Kd {} {} {} is not a reflectance (each channel must be a \
+                     finite number, at least 0)",
                     m.name, kd[0], kd[1], kd[2]
                 ));
             }
-            rho
+            (rho, RhoSource::Kd)
         }
-        None => [DEFAULT_GREY; 3],
+        None => ([DEFAULT_GREY; 3], RhoSource::Default),
     };
     let ke = match (m.emissive, m.unknown_param.get("Ke")) {
         (Some(ke), _) => ke.map(to_f64),
@@ -61,7 +67,98 @@ pub(super) fn convert_material(m: &tobj::Material) -> Result<Material, String> {
         name: m.name.clone(),
         rho,
         ke,
+        rho_source,
     })
+}
+
+/// ρ = `Kd` × the mean colour of `map_Kd` where the texture loads (one warning, naming each
+/// material and file, for those that do not: they keep `Kd` alone), then every channel of 1 or
+/// more clamped to [`MAX_REFLECTANCE`] (one warning naming the materials). `materials[i]` is
+/// the conversion of `tobj_materials[i]`.
+pub(super) fn textures_and_clamp(
+    name: &str,
+    tobj_materials: &[tobj::Material],
+    materials: &mut [Material],
+    warnings: &mut Vec<String>,
+) {
+    // (material index, the file as written, where it was looked for).
+    let textured: Vec<(usize, &str, PathBuf)> = tobj_materials
+        .iter()
+        .enumerate()
+        .filter_map(|(i, m)| {
+            let file = map_file(m.diffuse_texture.as_deref()?);
+            let folder = m.unknown_param.get(FOLDER_KEY).map_or("", String::as_str);
+            Some((i, file, resolve(Path::new(folder), file)))
+        })
+        .collect();
+    let paths: Vec<PathBuf> = textured.iter().map(|(_, _, p)| p.clone()).collect();
+    let means = mean_colours(&paths);
+    let mut failed = Vec::new();
+    for (i, file, path) in textured {
+        let material = &mut materials[i];
+        let outcome = if file.is_empty() {
+            Err("no file name after the options".to_string())
+        } else {
+            means[&path].clone()
+        };
+        match outcome {
+            Ok(mean) => {
+                let kd = match material.rho_source {
+                    RhoSource::Default => [1.0; 3],
+                    _ => material.rho,
+                };
+                material.rho = [0, 1, 2].map(|c| kd[c] * mean[c]);
+                material.rho_source = RhoSource::KdTimesTexture {
+                    file: file.to_string(),
+                    kd,
+                    mean,
+                };
+            }
+            Err(why) => {
+                failed.push(format!("'{}' ({}: {why})", material.name, path.display()));
+                let fallback = std::mem::take(&mut material.rho_source);
+                material.rho_source = RhoSource::TextureNotLoaded {
+                    file: file.to_string(),
+                    fallback: Box::new(fallback),
+                };
+            }
+        }
+    }
+    if !failed.is_empty() {
+        warnings.push(format!(
+            "{name}: {} texture(s) not loaded, so those materials use Kd alone: {}",
+            failed.len(),
+            list(&failed)
+        ));
+    }
+
+    let mut clamped = Vec::new();
+    for m in materials.iter_mut() {
+        if m.rho.iter().any(|r| *r >= 1.0) {
+            let unclamped = m.rho;
+            m.rho = unclamped.map(|r| if r >= 1.0 { MAX_REFLECTANCE } else { r });
+            let from = Box::new(std::mem::take(&mut m.rho_source));
+            m.rho_source = RhoSource::Clamped { unclamped, from };
+            clamped.push(format!("'{}'", m.name));
+        }
+    }
+    if !clamped.is_empty() {
+        warnings.push(format!(
+            "{name}: a reflectance of 1 or more is clamped to {MAX_REFLECTANCE} (a closed room \
+             that reflects everything never converges) in material(s) {}",
+            list(&clamped)
+        ));
+    }
+}
+
+/// `a, b, c`, shortened after 20 items.
+fn list(items: &[String]) -> String {
+    const SHOWN: usize = 20;
+    let mut out = items[..items.len().min(SHOWN)].join(", ");
+    if items.len() > SHOWN {
+        out += &format!(" and {} more", items.len() - SHOWN);
+    }
+    out
 }
 
 /// The material of faces without one: grey, named "default" unless the library has that name.
@@ -76,6 +173,7 @@ pub(super) fn default_grey(materials: &[Material]) -> Material {
         name: name.into(),
         rho: [DEFAULT_GREY; 3],
         ke: [0.0; 3],
+        rho_source: RhoSource::Default,
     }
 }
 
@@ -116,7 +214,14 @@ pub(super) fn load_library(
                     }
                     Ok(bytes) => {
                         let text = String::from_utf8_lossy(&bytes);
-                        all.extend(parse_library(&part, &text, log).0);
+                        // Its textures are named relative to its folder.
+                        let path = dir.join(&part);
+                        let folder = path.parent().unwrap_or(Path::new(""));
+                        let folder = folder.display().to_string();
+                        all.extend(parse_library(&part, &text, log).0.into_iter().map(|mut m| {
+                            m.unknown_param.insert(FOLDER_KEY.into(), folder.clone());
+                            m
+                        }));
                     }
                 }
             }
@@ -149,6 +254,8 @@ impl<M: Default> ResultOk for Result<(Vec<tobj::Material>, M), tobj::LoadError> 
 /// Parse one library's text, checked first; on a problem, log it and return no materials.
 fn parse_library(lib_name: &str, text: &str, log: &mut MtlLog) -> (Vec<tobj::Material>, MtlIndex) {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let normalized = normalize(text);
+    let text: &str = &normalized;
     let fixed = match check_mtl(text) {
         Ok(fixed) => fixed,
         Err(problem) => {

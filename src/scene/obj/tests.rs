@@ -3,7 +3,7 @@
 use super::mtl::{parse_colour, to_f64};
 use super::text::{name_list, one_line, snippet};
 use super::*;
-use crate::scene::{default_scene, DEFAULT_SCENE_NAME};
+use crate::scene::{default_scene, RhoSource, DEFAULT_SCENE_NAME, MAX_REFLECTANCE};
 use glam::DVec3;
 
 const GREY_MTL: &str = "newmtl grey\nKd 0.5 0.5 0.5\n";
@@ -528,19 +528,45 @@ fn no_polygons_is_an_error() {
 const TRIANGLE_USING_M: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
 
 #[test]
-fn reflectance_outside_zero_one_is_an_error() {
-    for kd in ["1 0.5 0.5", "0.5 -0.1 0.5", "0.5 0.5 nan"] {
+fn negative_or_non_finite_reflectance_is_an_error() {
+    for kd in ["0.5 -0.1 0.5", "0.5 0.5 nan", "inf 0.5 0.5"] {
         let mtl = format!("newmtl m\nKd {kd}\n");
-        let message = assert_error(
+        assert_error(
             load_strs(TRIANGLE_USING_M, &mtl),
             "test.obj",
-            &["'m'", "Kd"],
+            &["'m'", "Kd", "not a reflectance", "at least 0"],
         );
-        assert!(message.contains("outside [0, 1)"), "{message}");
     }
-    // Just below 1 is fine.
+    // Just below 1 is kept as it is, without a warning.
     let scene = load_strs(TRIANGLE_USING_M, "newmtl m\nKd 0.999 0 0\n").unwrap();
     assert_eq!(scene.materials[0].rho, [0.999, 0.0, 0.0]);
+    assert_eq!(scene.materials[0].rho_source, RhoSource::Kd);
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+}
+
+#[test]
+fn reflectance_of_one_or_more_is_clamped_with_one_warning() {
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
+               usemtl white\nf 1 2 3\nusemtl hot\nf 1 3 2\nusemtl fine\nf 2 1 3\n";
+    let mtl = "newmtl white\nKd 1 1 1\nnewmtl hot\nKd 1.5 0.5 0.25\nnewmtl fine\nKd 0.5 0.5 0.5\n";
+    let scene = load_strs(obj, mtl).unwrap();
+    assert_eq!(material(&scene, "white").rho, [MAX_REFLECTANCE; 3]);
+    assert_eq!(material(&scene, "hot").rho, [MAX_REFLECTANCE, 0.5, 0.25]);
+    assert_eq!(material(&scene, "fine").rho, [0.5; 3]);
+    assert_eq!(
+        material(&scene, "hot").rho_source,
+        RhoSource::Clamped {
+            unclamped: [1.5, 0.5, 0.25],
+            from: Box::new(RhoSource::Kd)
+        }
+    );
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    let w = &scene.warnings[0];
+    for needle in ["test.obj", "clamped to 0.98", "'white'", "'hot'"] {
+        assert!(w.contains(needle), "{w:?} lacks {needle:?}");
+    }
+    assert!(!w.contains("'fine'"), "{w}");
+    const { assert!(MAX_REFLECTANCE < 1.0) };
 }
 
 #[test]
@@ -592,4 +618,281 @@ fn helpers_behave() {
     assert_eq!(parse_colour("1 2"), None);
     assert_eq!(name_list(&[]), "none");
     assert_eq!(snippet(&"x".repeat(100)).len(), 60);
+}
+
+// ---- OBJ spellings: comments after the data, continued lines ----
+
+#[test]
+fn comments_after_the_data_are_ignored() {
+    let obj = "mtllib m.mtl   # the library\n\
+               v 0 0 0   # note\nv 1 0 0 #x\nv 0 1 0\t# tab\nv 1 1 0# no space\n\
+               g room # group\nusemtl grey # x\nf 1 2 3 # door\nf 2 4 3#\n";
+    let mtl = "newmtl grey # the walls\nKd 0.5 0.5 0.5 # grey\nKe 0.25 # dim\n";
+    let scene = load_strs(obj, mtl).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.positions.len(), 4);
+    assert_eq!(scene.polygons.len(), 2);
+    let m = &scene.materials[scene.polygons[0].material as usize];
+    assert_eq!(
+        (m.name.as_str(), m.rho, m.ke),
+        ("grey", [0.5; 3], [0.25; 3])
+    );
+}
+
+#[test]
+fn a_hash_inside_a_name_is_part_of_it() {
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wall#2 # comment\nf 1 2 3\n";
+    let scene = load_strs(obj, "newmtl wall#2\nKd 0.25 0.25 0.25\n").unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.materials[0].name, "wall#2");
+    assert_eq!(scene.materials[0].rho, [0.25; 3]);
+}
+
+#[test]
+fn backslash_continues_a_line() {
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 \\\n  0\nv 1 1 0\nv 0 1 0\nusemtl grey\n\
+               f 1 \\\n2 \\\n  3 \\\r\n4   # a quad over four lines\nf 1 2 3\n";
+    let scene = load_strs(obj, GREY_MTL).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert_eq!(scene.positions.len(), 4);
+    let arities: Vec<u32> = scene.polygons.iter().map(|p| p.len).collect();
+    assert_eq!(arities, [4, 3]);
+    assert_eq!(scene.positions[1], Vec3::new(1.0, 0.0, 0.0));
+}
+
+#[test]
+fn a_backslash_in_a_comment_continues_nothing() {
+    let obj = "v 0 0 0 # ends in \\\nv 1 0 0\nv 0 1 0\n# a comment \\\nf 1 2 3\n";
+    let scene = load_strs(obj, "").unwrap();
+    assert_eq!(scene.positions.len(), 3);
+    assert_eq!(scene.polygons.len(), 1);
+}
+
+#[test]
+fn errors_name_the_original_line_after_continued_lines() {
+    // Lines 2-4 are one vertex; line 7 is the bad face.
+    let obj = "# model\nv 0 \\\n0 \\\n0\nv 1 0 0 # x\nv 0 1 0\nf 1 2 x\n";
+    assert_error(
+        load_strs(obj, ""),
+        "test.obj",
+        &["line 7", "cannot read a face", "f 1 2 x"],
+    );
+    let obj = "v 0 0 0\nf 1 \\\n 2 \\\n 3\nv 1 0 0\nf 1 \\\n 2\n";
+    assert_error(
+        load_strs(obj, ""),
+        "test.obj",
+        &["line 6", "a face with 2 vertices"],
+    );
+    let obj = "v 0 0 0\nv 1 0 0\\\n\nv 0 1 0\nf 1 2 9 # far\n";
+    assert_error(
+        load_strs(obj, ""),
+        "test.obj",
+        &["line 5", "vertex 9", "has 3 vertices"],
+    );
+    let mtl = "newmtl m\nKd 0.5 \\\n 0.5\nNs \\\n shiny\n";
+    assert_error(
+        load_strs(TRIANGLE_USING_M, mtl),
+        "test.obj",
+        &["line 2", "needs 3 numbers"],
+    );
+}
+
+#[test]
+fn the_patch_size_comment_still_reads() {
+    let obj = "# radiosity: patch-size 0.5\nv 0 0 0 # a\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let scene = load_strs(obj, "").unwrap();
+    assert_eq!(scene.patch_size_hint, Some(0.5));
+}
+
+#[test]
+fn normalize_keeps_every_line_at_its_number() {
+    use super::text::normalize;
+    assert!(matches!(
+        normalize("v 0 0 0\n# c\n"),
+        std::borrow::Cow::Borrowed(_)
+    ));
+    let text = "a \\\nb\nc # x\n# d \\\ne \\\n# f\ng\\";
+    let out = normalize(text);
+    assert_eq!(out.lines().count(), text.lines().count());
+    assert_eq!(out, "a  b\n\nc\n# d \\\ne  \n\ng \n");
+}
+
+// ---- textures ----
+
+/// A folder with `model.obj` (a lit triangle of material `m`), `mat/m.mtl` holding `mtl` and
+/// the files `files` (paths relative to the folder).
+fn textured(mtl: &str, files: &[(&str, Vec<u8>)]) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.obj");
+    std::fs::write(
+        &path,
+        "mtllib mat/m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::create_dir_all(dir.path().join("mat")).unwrap();
+    std::fs::write(dir.path().join("mat/m.mtl"), mtl).unwrap();
+    for (name, bytes) in files {
+        let file = dir.path().join(name);
+        std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+        std::fs::write(file, bytes).unwrap();
+    }
+    (dir, path)
+}
+
+/// An image of `texels` (RGB, 8-bit) in one row, encoded as `format`.
+fn encode(texels: &[[u8; 3]], format: image::ImageFormat) -> Vec<u8> {
+    let image = image::RgbImage::from_fn(texels.len() as u32, 1, |x, _| {
+        image::Rgb(texels[x as usize])
+    });
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut bytes, format).unwrap();
+    bytes.into_inner()
+}
+
+fn close(a: [f64; 3], b: [f64; 3], tol: f64) -> bool {
+    (0..3).all(|c| (a[c] - b[c]).abs() <= tol)
+}
+
+#[test]
+fn reflectance_is_kd_times_the_mean_texture_colour_in_linear_light() {
+    // Half black, half white: 0.5 in linear light (an sRGB mean would say so too, but see
+    // the grey below).
+    let half = encode(
+        &[[0; 3], [255; 3], [0; 3], [255; 3]],
+        image::ImageFormat::Png,
+    );
+    // sRGB 188 is 0.5 in linear light (not 0.737).
+    let grey = encode(&[[188, 188, 188]], image::ImageFormat::Png);
+    let mtl = "newmtl m\nKd 0.8 0.6 0.4\nmap_Kd -s 1 1 1 -bm 1 -clamp on textures/half.png\n\
+               newmtl g\nKd 1 1 1\nmap_Kd textures/grey.png # grey\n";
+    let (_dir, path) = textured(
+        mtl,
+        &[
+            ("mat/textures/half.png", half),
+            ("mat/textures/grey.png", grey),
+        ],
+    );
+    let scene = load_obj(&path, &LoadOptions::default()).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    let m = material(&scene, "m");
+    assert!(close(m.rho, [0.4, 0.3, 0.2], 1e-12), "{:?}", m.rho);
+    assert_eq!(
+        m.rho_source,
+        RhoSource::KdTimesTexture {
+            file: "textures/half.png".into(),
+            kd: [0.8, 0.6, 0.4],
+            mean: [0.5; 3]
+        }
+    );
+    // Kd 1 1 1 with a texture, as exporters write it: ρ is the texture's mean, no clamp.
+    let g = material(&scene, "g");
+    assert!(close(g.rho, [0.5; 3], 0.005), "{:?}", g.rho);
+    assert!(matches!(g.rho_source, RhoSource::KdTimesTexture { .. }));
+}
+
+#[test]
+fn jpeg_tga_and_bmp_textures_decode() {
+    let colour = [[200, 100, 50]; 16];
+    let expected = [200.0, 100.0, 50.0].map(|v: f64| super::texture::srgb_to_linear(v / 255.0));
+    for (ext, format) in [
+        ("jpg", image::ImageFormat::Jpeg),
+        ("tga", image::ImageFormat::Tga),
+        ("bmp", image::ImageFormat::Bmp),
+    ] {
+        let file = format!("t.{ext}");
+        let mtl = format!("newmtl m\nKd 0.9 0.9 0.9\nmap_Kd ../{file}\n");
+        let (_dir, path) = textured(&mtl, &[(&file, encode(&colour, format))]);
+        let scene = load_obj(&path, &LoadOptions::default()).unwrap();
+        assert!(scene.warnings.is_empty(), "{ext}: {:?}", scene.warnings);
+        let rho = scene.materials[0].rho;
+        // JPEG is lossy: a few levels of 255.
+        assert!(
+            close(rho, expected.map(|e| 0.9 * e), 0.02),
+            "{ext}: {rho:?}"
+        );
+    }
+}
+
+#[test]
+fn a_texture_that_does_not_load_is_one_warning_and_kd_alone() {
+    let mtl = "newmtl m\nKd 0.25 0.5 0.75\nmap_Kd missing.png\n\
+               newmtl broken\nKd 0.5 0.5 0.5\nmap_Kd broken.png\n\
+               newmtl bare\nmap_Kd -bm 1\n";
+    let (_dir, path) = textured(mtl, &[("mat/broken.png", b"not a png".to_vec())]);
+    let scene = load_obj(&path, &LoadOptions::default()).unwrap();
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    let w = &scene.warnings[0];
+    for needle in [
+        "3 texture(s) not loaded",
+        "Kd alone",
+        "'m'",
+        "missing.png: no such file",
+        "'broken'",
+        "broken.png: cannot decode",
+        "'bare'",
+        "no file name",
+    ] {
+        assert!(w.contains(needle), "{w:?} lacks {needle:?}");
+    }
+    let m = material(&scene, "m");
+    assert_eq!(m.rho, [0.25, 0.5, 0.75]);
+    assert_eq!(
+        m.rho_source,
+        RhoSource::TextureNotLoaded {
+            file: "missing.png".into(),
+            fallback: Box::new(RhoSource::Kd)
+        }
+    );
+    assert_eq!(material(&scene, "bare").rho, [0.5; 3]);
+}
+
+#[test]
+fn texture_paths_as_windows_exporters_write_them() {
+    let white = encode(&[[255; 3]], image::ImageFormat::Png);
+    let mtl = "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd Textures\\WALL.PNG\n";
+    let (_dir, path) = textured(mtl, &[("mat/Textures/wall.png", white)]);
+    let scene = load_obj(&path, &LoadOptions::default()).unwrap();
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+    assert!(close(scene.materials[0].rho, [0.5; 3], 1e-12));
+}
+
+#[test]
+fn a_texture_that_makes_one_or_more_is_clamped() {
+    let white = encode(&[[255; 3]], image::ImageFormat::Png);
+    let mtl = "newmtl m\nKd 1 1 1\nmap_Kd white.png\n";
+    let (_dir, path) = textured(mtl, &[("mat/white.png", white)]);
+    let scene = load_obj(&path, &LoadOptions::default()).unwrap();
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    assert!(scene.warnings[0].contains("'m'"), "{:?}", scene.warnings);
+    assert_eq!(scene.materials[0].rho, [MAX_REFLECTANCE; 3]);
+    let RhoSource::Clamped { from, .. } = &scene.materials[0].rho_source else {
+        panic!("{:?}", scene.materials[0].rho_source);
+    };
+    assert!(matches!(**from, RhoSource::KdTimesTexture { .. }));
+}
+
+#[test]
+fn map_file_skips_the_options() {
+    use super::texture::map_file;
+    for (value, file) in [
+        ("wall.png", "wall.png"),
+        ("-s 1 1 1 wall.png", "wall.png"),
+        ("-s 2 wall.png", "wall.png"),
+        (
+            "-bm 1 -o 0 0 0 -t 0.1 0.1 textures/wall.png",
+            "textures/wall.png",
+        ),
+        (
+            "-clamp on -blendu off -imfchan r -mm 0 1 a b.png",
+            "a b.png",
+        ),
+        ("-type sphere -texres 512 -boost 2 w.jpg", "w.jpg"),
+        ("my wall.png", "my wall.png"),
+        ("-bm", "-bm"),
+        ("-bm 1", ""),
+        ("", ""),
+        ("-s 1 1 1 -tex.png", "-tex.png"),
+    ] {
+        assert_eq!(map_file(value), file, "{value}");
+    }
 }

@@ -290,3 +290,97 @@ pub(super) fn io_reason(e: &std::io::Error) -> String {
         _ => e.to_string(),
     }
 }
+
+/// The OBJ/MTL spellings tobj does not read, rewritten away with every line kept at its
+/// original number (so every message names the line of the file):
+/// - a `#` comment after the data (`v 0 0 0  # note`, `usemtl wall # x`) is cut off; a whole
+///   comment line is left as it is (it may be the patch-size comment);
+/// - a line ending in a backslash continues on the next one (the OBJ specification's line
+///   continuation, as exporters write long `f` lines): the lines are joined onto the first,
+///   the backslash read as a space, and each line taken into it is left empty in its place.
+///   A backslash inside a trailing comment is part of the comment, not a continuation.
+///
+/// Borrowed when there is nothing to rewrite.
+pub(super) fn normalize(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.contains(['#', '\\']) {
+        return text.into();
+    }
+    if !text.lines().any(|line| {
+        let (data, continues) = statement(line, false);
+        continues || data.len() != line.len()
+    }) {
+        return text.into();
+    }
+    let mut out = String::with_capacity(text.len());
+    // The lines joined so far, and how many lines they took.
+    let mut joined = String::new();
+    let mut taken = 0usize;
+    for line in text.lines() {
+        let (data, continues) = statement(line, taken > 0);
+        joined.push_str(data);
+        taken += 1;
+        if continues {
+            joined.push(' ');
+            continue;
+        }
+        out.push_str(&joined);
+        out.extend(std::iter::repeat_n('\n', taken));
+        joined.clear();
+        taken = 0;
+    }
+    // A backslash on the last line continues onto nothing.
+    out.push_str(&joined);
+    out.extend(std::iter::repeat_n('\n', taken));
+    out.into()
+}
+
+/// A line's data (without a comment after it and without the continuation backslash), and
+/// whether it continues on the next line. A line that is all comment is data as it is (tobj
+/// skips it), unless it continues a statement: then it is empty and ends the statement.
+fn statement(line: &str, continuing: bool) -> (&str, bool) {
+    if line.trim_start().starts_with('#') {
+        return (if continuing { "" } else { line }, false);
+    }
+    let data = strip_comment(line);
+    match data.trim_end().strip_suffix('\\') {
+        Some(head) => (head, true),
+        None => (data, false),
+    }
+}
+
+/// `line` without a comment after its data. A line that is all comment is returned whole.
+/// In a statement that carries a name (`usemtl`, `newmtl`, `mtllib`, `g`, `o`, `map_Kd`, …)
+/// only a `#` that begins a word starts a comment (`wall#2` is a name); in any other
+/// statement (numbers: `v`, `f`, `Kd`, …) the first `#` does.
+fn strip_comment(line: &str) -> &str {
+    let trimmed = line.trim_start();
+    if trimmed.starts_with('#') || !line.contains('#') {
+        return line;
+    }
+    let key = trimmed.split_whitespace().next().unwrap_or("");
+    let names = matches!(
+        key,
+        "usemtl"
+            | "newmtl"
+            | "mtllib"
+            | "g"
+            | "o"
+            | "s"
+            | "bump"
+            | "disp"
+            | "decal"
+            | "refl"
+            | "norm"
+    ) || key.starts_with("map_");
+    let cut = if names {
+        line.char_indices()
+            .find(|&(i, c)| c == '#' && line[..i].ends_with(char::is_whitespace))
+            .map(|(i, _)| i)
+    } else {
+        line.find('#')
+    };
+    match cut {
+        Some(i) => line[..i].trim_end(),
+        None => line,
+    }
+}
