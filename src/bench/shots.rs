@@ -443,35 +443,14 @@ pub fn bench_shots(
     let kept = switch::KEPT;
     let fitted = fit_model(&cube_samples, &ray_samples);
 
-    let hybrids = vec![
-        hybrid(
-            &scene,
-            &m,
-            &isect,
-            cfg,
-            "counted, kept constants",
-            SwitchBy::Counted,
-            kept,
-        )?,
-        hybrid(
-            &scene,
-            &m,
-            &isect,
-            cfg,
-            "counted, fitted constants",
-            SwitchBy::Counted,
-            fitted,
-        )?,
-        hybrid(
-            &scene,
-            &m,
-            &isect,
-            cfg,
-            "measured",
-            SwitchBy::Measured,
-            kept,
-        )?,
-    ];
+    let hybrids = [
+        ("counted, kept constants", SwitchBy::Counted, kept),
+        ("counted, fitted constants", SwitchBy::Counted, fitted),
+        ("measured", SwitchBy::Measured, kept),
+    ]
+    .into_iter()
+    .map(|(rule, by, model)| hybrid(&scene, &m, &isect, cfg, rule, by, model))
+    .collect::<Result<Vec<_>, _>>()?;
     let default = &hybrids[0];
     Ok(ShotBench {
         scene: scene.name.clone(),
