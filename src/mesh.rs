@@ -39,6 +39,24 @@ pub struct Patch {
     pub centre: Vec3,
     pub normal: Vec3,
     pub class: PatchClass,
+    /// Which side of its surface this patch is (docs/design.md §7).
+    pub side: Side,
+}
+
+/// Sides (docs/design.md §7). Every geometric surface goes to the intersectors and the hemi-cube
+/// once, as its front patch; a two-sided surface also has a back patch, its *twin*: the same
+/// polygon wound the other way, with a material of its own, which no intersector sees. Which
+/// side a ray meets decides which of the two receives it ([`Mesh::receiver`]), so light is never
+/// lost to the wrong twin, and two coincident triangles never race in a BVH or a Z-buffer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Side {
+    /// One-sided: light meeting its back is absorbed there (books: "absorbed on back faces").
+    #[default]
+    One,
+    /// The front of a two-sided surface; `back` is its twin.
+    Front { back: u32 },
+    /// The back of a two-sided surface; `front` is the patch the intersectors see.
+    Back { front: u32 },
 }
 
 /// The patches of a scene and their welded display vertices.
@@ -54,6 +72,37 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// Whether patch `i` is a surface the intersectors and the hemi-cube see (not a back twin).
+    pub fn is_surface(&self, i: usize) -> bool {
+        !matches!(self.patches[i].side, Side::Back { .. })
+    }
+
+    /// The patch that receives light meeting surface patch `patch` on its front (`back` false)
+    /// or its back: the patch itself, its back twin, or `None` for the back of a one-sided
+    /// patch (that light is absorbed there).
+    pub fn receiver(&self, patch: u32, back: bool) -> Option<u32> {
+        match (back, self.patches[patch as usize].side) {
+            (false, _) => Some(patch),
+            (true, Side::Front { back }) => Some(back),
+            (true, _) => None,
+        }
+    }
+
+    /// The surface patch `i` is a side of: itself, or the front patch of a back twin.
+    pub fn surface_of(&self, i: usize) -> usize {
+        match self.patches[i].side {
+            Side::Back { front } => front as usize,
+            _ => i,
+        }
+    }
+
+    /// How many patches are back twins.
+    pub fn back_twins(&self) -> usize {
+        (0..self.patches.len())
+            .filter(|&i| !self.is_surface(i))
+            .count()
+    }
+
     /// The vertex indices of patch `i`.
     pub fn patch_indices(&self, i: usize) -> &[u32] {
         let p = &self.patches[i];
@@ -155,16 +204,16 @@ pub fn patch_size(scene: &Scene, opts: &MeshOptions) -> f32 {
 /// patch size)² cells for each of its n − 2 triangles. Cheap: no polygon is cut.
 pub fn rough_patch_count(scene: &Scene, opts: &MeshOptions) -> f64 {
     let size = patch_size(scene, opts) as f64;
-    let sides = if opts.two_sided { 2.0 } else { 1.0 };
     let per_polygon = |p: &crate::scene::Polygon| {
+        let sides = if back_material(scene, p, opts).is_some() { 2.0 } else { 1.0 };
         let pts = polygon_points(scene, p);
         let (lo, hi) = pts
             .iter()
             .fold((pts[0], pts[0]), |(l, h), v| (l.min(*v), h.max(*v)));
         let k = ((hi - lo).length() as f64 / size).ceil().max(1.0);
-        k * k * (pts.len().max(3) - 2) as f64
+        sides * k * k * (pts.len().max(3) - 2) as f64
     };
-    sides * scene.polygons.iter().map(per_polygon).sum::<f64>()
+    scene.polygons.iter().map(per_polygon).sum::<f64>()
 }
 
 /// [`build`], refusing (one line, for a [`crate::scene::SceneError`]) a patch size that
@@ -188,14 +237,26 @@ pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
     let mut b = Builder::new(size, (hi - lo).length().max(f32::MIN_POSITIVE));
     for (pi, poly) in scene.polygons.iter().enumerate() {
         let pts = polygon_points(scene, poly);
+        let back = back_material(scene, poly, opts);
         for piece in planar_convex_pieces(&pts) {
-            b.add_polygon(&piece, poly.material, pi as u32, false);
-            if opts.two_sided {
-                b.add_polygon(&piece, poly.material, pi as u32, true);
+            let start = b.mesh.patches.len();
+            b.add_polygon(&piece, poly.material, pi as u32);
+            if let Some(m) = back {
+                b.add_back_twins(start, m);
             }
         }
     }
     b.mesh
+}
+
+/// The material of a polygon's back side, if it has one (docs/design.md §7): its own (a
+/// doubled face merged at load time), else with `--two-sided` its front material — except for
+/// an emitter, whose light leaves its front only (as Radiance's `light`): a lamp stays one-sided.
+pub fn back_material(scene: &Scene, poly: &crate::scene::Polygon, opts: &MeshOptions) -> Option<u32> {
+    poly.back_material.or_else(|| {
+        (opts.two_sided && !scene.materials[poly.material as usize].is_emitter())
+            .then_some(poly.material)
+    })
 }
 
 /// Splits a face into planar convex pieces: itself when it already is one, else triangles
@@ -316,12 +377,7 @@ impl Builder {
     }
 
     /// Cuts one planar convex polygon into patches no longer than the patch size.
-    fn add_polygon(&mut self, pts: &[Vec3], material: u32, polygon: u32, back: bool) {
-        let pts: Vec<Vec3> = if back {
-            pts.iter().rev().copied().collect()
-        } else {
-            pts.to_vec()
-        };
+    fn add_polygon(&mut self, pts: &[Vec3], material: u32, polygon: u32) {
         let n = newell(&pts).normalize_or_zero();
         if n == Vec3::ZERO {
             return;
@@ -430,6 +486,36 @@ impl Builder {
         }
     }
 
+    /// Gives each patch from `start` on a back twin of `material` (docs/design.md §7): the same
+    /// polygon wound the other way, on vertices of its own (welded with the back's facing).
+    fn add_back_twins(&mut self, start: usize, material: u32) {
+        for k in start..self.mesh.patches.len() {
+            let front = self.mesh.patches[k];
+            let ring: Vec<Vec3> = self
+                .mesh
+                .patch_indices(k)
+                .iter()
+                .rev()
+                .map(|&v| self.mesh.vertices[v as usize])
+                .collect();
+            let ids: Vec<u32> = ring
+                .iter()
+                .map(|&p| self.vertex(p, -front.normal, material))
+                .collect();
+            let twin = self.mesh.patches.len() as u32;
+            let first = self.mesh.patch_vertices.len() as u32;
+            self.mesh.patch_vertices.extend_from_slice(&ids);
+            self.mesh.patches.push(Patch {
+                first,
+                material,
+                normal: -front.normal,
+                side: Side::Back { front: k as u32 },
+                ..front
+            });
+            self.mesh.patches[k].side = Side::Front { back: twin };
+        }
+    }
+
     fn push_patch(&mut self, ids: &[u32], n: Vec3, material: u32, polygon: u32) {
         let pts: Vec<Vec3> = ids
             .iter()
@@ -465,6 +551,7 @@ impl Builder {
             centre,
             normal: n,
             class: classify(&pts, n),
+            side: Side::One,
         });
     }
 }
@@ -523,10 +610,22 @@ impl Mesh {
             .collect()
     }
 
-    /// Fan triangles of every patch, as (vertex indices, patch id): what Embree and the
-    /// rasterizer consume.
+    /// Fan triangles of every patch, as (vertex indices, patch id): what exports draw.
     pub fn triangles(&self) -> impl Iterator<Item = ([u32; 3], u32)> + '_ {
-        (0..self.patches.len()).flat_map(move |i| {
+        self.triangles_of(0..self.patches.len())
+    }
+
+    /// Fan triangles of the surface patches only ([`Mesh::is_surface`]): what intersectors
+    /// are built from.
+    pub fn surface_triangles(&self) -> impl Iterator<Item = ([u32; 3], u32)> + '_ {
+        self.triangles_of((0..self.patches.len()).filter(move |&i| self.is_surface(i)))
+    }
+
+    fn triangles_of<'a>(
+        &'a self,
+        patches: impl Iterator<Item = usize> + 'a,
+    ) -> impl Iterator<Item = ([u32; 3], u32)> + 'a {
+        patches.flat_map(move |i| {
             let ids = self.patch_indices(i);
             (1..ids.len() - 1).map(move |k| ([ids[0], ids[k], ids[k + 1]], i as u32))
         })
@@ -558,6 +657,7 @@ mod tests {
                 first,
                 len: f.len() as u32,
                 material: 0,
+                back_material: None,
             });
         }
         s
@@ -674,6 +774,50 @@ mod tests {
         let back = m.patches.iter().filter(|p| p.normal.z < 0.0).count();
         assert_eq!(back, 4);
         assert_eq!(m.vertices.len(), 18, "front and back never share a vertex");
+        // Each front patch and its twin name each other, and only fronts are surfaces.
+        for (i, p) in m.patches.iter().enumerate() {
+            match p.side {
+                Side::Front { back } => {
+                    let t = &m.patches[back as usize];
+                    assert_eq!(t.side, Side::Back { front: i as u32 });
+                    assert_eq!((t.area, t.centre, t.normal), (p.area, p.centre, -p.normal));
+                    assert!(m.is_surface(i) && !m.is_surface(back as usize));
+                    assert_eq!(m.receiver(i as u32, true), Some(back));
+                    assert_eq!(m.surface_of(back as usize), i);
+                }
+                Side::Back { .. } => {}
+                Side::One => panic!("patch {i} has no twin"),
+            }
+        }
+        assert_eq!(m.surface_triangles().count(), 8, "4 quads, 2 triangles each");
+        assert_eq!(m.triangles().count(), 16);
+    }
+
+    #[test]
+    fn an_emitter_stays_one_sided_and_a_merged_back_material_is_used() {
+        let quad = [
+            vec3(0., 0., 0.),
+            vec3(1., 0., 0.),
+            vec3(1., 1., 0.),
+            vec3(0., 1., 0.),
+        ];
+        let mut s = scene_of(&[&quad, &quad.map(|v| v + Vec3::Z)]);
+        s.materials.push(Material {
+            name: "lamp".into(),
+            ke: [1.0; 3],
+            ..Material::default()
+        });
+        s.polygons[0].material = 1;
+        s.polygons[1].back_material = Some(1);
+        let two = MeshOptions {
+            patch_size: Some(1.0),
+            two_sided: true,
+        };
+        let m = build(&s, &two);
+        assert_eq!(m.patches.len(), 3, "lamp one-sided, the other two-sided");
+        assert_eq!(m.patches[0].side, Side::One);
+        assert_eq!(m.patches[2].material, 1, "the merged back material");
+        assert_eq!(build(&s, &opts(1.0)).back_twins(), 1, "merged faces need no flag");
     }
 
     #[test]

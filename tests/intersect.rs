@@ -57,6 +57,7 @@ fn poly(s: &mut Scene, pts: &[Vec3]) {
         first,
         len: pts.len() as u32,
         material: 0,
+        back_material: None,
     });
 }
 

@@ -32,7 +32,7 @@
 //! invalidating the patches. A command given both a scene and a solution refuses a solution
 //! whose hash differs ([`SavedSolution::check_scene`]).
 
-use crate::mesh::{Axis, Mesh, Patch, PatchClass};
+use crate::mesh::{Axis, Mesh, Patch, PatchClass, Side};
 use crate::scene::Scene;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -513,6 +513,8 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
                 3 => PatchClass::Skew,
                 _ => return None,
             },
+            // The file keeps no twins: a saved solution is drawn, never cast into (§7).
+            side: Side::One,
         })
     })?;
     let b = records(get(b"BRAD")?, 24, "BRAD", |c| c.f64x3())?;
@@ -615,6 +617,7 @@ mod tests {
             centre: Vec3::new(0.5, 0.5, 0.0),
             normal: Vec3::Z,
             class: PatchClass::Axial(Axis::Z),
+            side: Side::One,
         });
         SavedSolution {
             meta: SolutionMeta {

@@ -13,7 +13,7 @@ pub struct BruteForce {
 impl BruteForce {
     pub fn new(mesh: &Mesh) -> BruteForce {
         let tris = mesh
-            .triangles()
+            .surface_triangles()
             .map(|(t, p)| (t.map(|v| mesh.vertices[v as usize]), p))
             .collect();
         let normals = mesh.patches.iter().map(|p| p.normal).collect();

@@ -73,7 +73,8 @@ pub fn set_flush_denormals() {
 }
 
 impl EmbreeScene {
-    /// Builds a scene from the patches for which `keep(patch index)` holds.
+    /// Builds a scene from the surface patches (never a back twin, docs/design.md §7) for
+    /// which `keep(patch index)` holds.
     pub fn build(mesh: &Mesh, keep: impl Fn(usize) -> bool) -> Result<EmbreeScene, EmbreeError> {
         set_flush_denormals();
         let config = CString::new("verbose=0").expect("no NUL");
@@ -89,7 +90,7 @@ impl EmbreeScene {
             prim_patch: Vec::new(),
         };
         let mut index: Vec<u32> = Vec::new();
-        for (tri, patch) in mesh.triangles() {
+        for (tri, patch) in mesh.surface_triangles() {
             if keep(patch as usize) {
                 index.extend_from_slice(&tri);
                 me.prim_patch.push(patch);
@@ -219,7 +220,7 @@ impl Drop for EmbreeScene {
 mod tests {
     use super::*;
     use crate::intersect::brute::BruteForce;
-    use crate::mesh::{Patch, PatchClass};
+    use crate::mesh::{Patch, PatchClass, Side};
     use glam::{vec3, Vec3};
 
     /// One unit quad in z = 0, counter-clockwise seen from +z (its front).
@@ -241,6 +242,7 @@ mod tests {
                 centre: vec3(0.5, 0.5, 0.0),
                 normal: Vec3::Z,
                 class: PatchClass::Skew,
+                side: Side::One,
             }],
             patch_size: 1.0,
         }

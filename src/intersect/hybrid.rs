@@ -35,8 +35,9 @@ impl Hybrid {
     /// Builds the parts the mesh needs: the merge if it has axial patches, Embree if skew ones.
     pub fn build(mesh: &Mesh) -> Result<Hybrid, EmbreeError> {
         let skew = |i: usize| mesh.patches[i].class == PatchClass::Skew;
-        let n_skew = (0..mesh.patches.len()).filter(|&i| skew(i)).count();
-        let n_axial = mesh.patches.len() - n_skew;
+        let surfaces = || (0..mesh.patches.len()).filter(|&i| mesh.is_surface(i));
+        let n_skew = surfaces().filter(|&i| skew(i)).count();
+        let n_axial = surfaces().count() - n_skew;
         let merge = (n_axial > 0)
             .then(|| PlaneMerge::build(mesh))
             .filter(|m| !m.is_empty());

@@ -25,13 +25,27 @@ pub struct Run<'a> {
     pub t0: Instant,
 }
 
+/// Share of the emitted light lost on back faces above which a solve warns: a consistently
+/// wound model loses none, so 1 % already means faces wound the wrong way.
+pub const BACK_WARNING: f64 = 0.01;
+/// Share of the emitted light escaping the model above which a solve warns (open models, such
+/// as a courtyard, lose some light to the sky legitimately; most of it means lights turned out).
+pub const ESCAPE_WARNING: f64 = 0.5;
+
 /// Warnings about a solution a user should hear of.
 fn solution_warnings(energy: &EnergyReport) -> Vec<String> {
     let mut w = Vec::new();
-    if energy.back_fraction > 0.05 {
+    // docs/design.md §7: a model with wrong winding never gives a silent black image.
+    if energy.back_fraction > BACK_WARNING {
         w.push(format!(
-            "{:.1} % of the emitted light arrived on back faces and was absorbed: are some normals flipped (faces wound clockwise)? Use --two-sided for thin surfaces seen from both sides",
+            "{:.1} % of the emitted light met the back of one-sided faces and was lost there (faces wound clockwise: an inside-out room, or mixed winding): solve with --two-sided",
             100.0 * energy.back_fraction
+        ));
+    }
+    if energy.escaped_fraction > ESCAPE_WARNING {
+        w.push(format!(
+            "{:.1} % of the emitted light left the model without meeting a surface: if the lights face away from the rooms (faces wound clockwise), solve with --flip",
+            100.0 * energy.escaped_fraction
         ));
     }
     w

@@ -115,7 +115,7 @@ fn near_plane(mesh: &Mesh) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::{Patch, PatchClass};
+    use crate::mesh::{Patch, PatchClass, Side};
 
     /// One patch per quad (corners counter-clockwise seen from the front), unwelded vertices.
     fn quads(qs: &[([Vec3; 4], [[f32; 3]; 4])]) -> (Mesh, Vec<[f32; 3]>) {
@@ -138,6 +138,7 @@ mod tests {
                 centre: corners.iter().sum::<Vec3>() / 4.0,
                 normal: n.normalize(),
                 class: PatchClass::Skew,
+                side: Side::One,
             });
         }
         (mesh, rgb)

@@ -8,6 +8,7 @@
 
 mod default;
 mod obj;
+pub mod sides;
 
 pub use default::{default_scene, DEFAULT_SCENE_MTL, DEFAULT_SCENE_NAME, DEFAULT_SCENE_OBJ};
 pub use obj::{load_obj, load_obj_from_strs, LoadOptions, SceneError};
@@ -128,6 +129,9 @@ pub struct Polygon {
     pub first: u32,
     pub len: u32,
     pub material: u32,
+    /// The material of the back side, for a two-sided polygon (a doubled face merged at load
+    /// time, [`sides`]); `None`: one-sided unless the mesh is built `--two-sided`.
+    pub back_material: Option<u32>,
 }
 
 /// A loaded model. Flat arrays so a million-polygon model costs no allocation per face.
@@ -145,6 +149,8 @@ pub struct Scene {
     /// The patch size the model's author intended, from a comment line
     /// `# radiosity: patch-size METRES` in the OBJ; used when no `--patch-size` is given.
     pub patch_size_hint: Option<f32>,
+    /// Coincident polygons merged at load time ([`sides::merge_coincident`]).
+    pub merged: sides::Merged,
 }
 
 impl Scene {

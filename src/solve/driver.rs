@@ -86,6 +86,8 @@ struct PatchScalars {
     emission: Vec<f64>,
     rho: Vec<f64>,
     rho_mean: f64,
+    /// Sides of two-sided surfaces (empty if the mesh has none).
+    twinned: Vec<bool>,
 }
 
 impl PatchScalars {
@@ -97,7 +99,14 @@ impl PatchScalars {
             .iter()
             .map(|p| scalar(&material(p).rho))
             .collect();
+        let twinned = if mesh.back_twins() > 0 {
+            let side = |p: &crate::mesh::Patch| p.side != crate::mesh::Side::One;
+            mesh.patches.iter().map(side).collect()
+        } else {
+            Vec::new()
+        };
         PatchScalars {
+            twinned,
             emission: mesh
                 .patches
                 .iter()
@@ -116,6 +125,7 @@ impl PatchScalars {
             rho: &self.rho,
             energy_per_ray,
             rho_mean: self.rho_mean,
+            twinned: &self.twinned,
         }
     }
 }
@@ -192,9 +202,19 @@ impl<'a, I: Intersector> Driver<'a, I> {
             .iter()
             .map(|p| materials[p.material as usize].rho)
             .collect();
-        let c = cfg.energy_per_ray.filter(|c| *c > 0.0).unwrap_or_else(|| {
-            energy_per_ray(mesh, &rho, scalar(&st.energy.emitted), cfg.tolerance)
-        });
+        // What the surfaces emit: a doubled lamp's back twin shines into the fixture or the
+        // void, and must not coarsen the room's sampling (docs/design.md §7).
+        let emitted: f64 = (0..n)
+            .filter(|&i| mesh.is_surface(i))
+            .map(|i| {
+                let p = &mesh.patches[i];
+                scalar(&materials[p.material as usize].emission()) * p.area
+            })
+            .sum();
+        let c = cfg
+            .energy_per_ray
+            .filter(|c| *c > 0.0)
+            .unwrap_or_else(|| energy_per_ray(mesh, &rho, emitted, cfg.tolerance));
         let cubes = match method {
             MethodKind::Hemicube | MethodKind::HemicubeJittered => Some(CubeKind::Uniform {
                 n: cfg.hemicube_n,

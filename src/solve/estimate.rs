@@ -80,6 +80,10 @@ pub struct Estimator<'a> {
     pub energy_per_ray: f64,
     /// Area-weighted mean reflectance: the share of shot light kept before anything is known.
     pub rho_mean: f64,
+    /// Per patch: a side of a two-sided surface (docs/design.md §7); empty when none is. A side
+    /// that has received nothing yet is presumed to face the void (the outside of a closed
+    /// room's walls) and owed nothing; one-sided patches are always owed their share.
+    pub twinned: &'a [bool],
 }
 
 /// What the solver knows at a trace point, per patch and in total (scalar).
@@ -109,14 +113,18 @@ impl Estimator<'_> {
         let owed = books.unshot * r / (1.0 - r);
         // Spread like light arriving evenly per unit area (the light still owed has bounced at
         // least once, and bounced light is far more even than direct light), kept at ρ_j.
-        let rho_area: f64 = self
-            .rho
-            .iter()
-            .zip(self.area)
-            .map(|(r, a)| r * a)
+        let n = self.area.len();
+        let dark = |j: usize| {
+            !self.twinned.is_empty()
+                && self.twinned[j]
+                && books.gathered[j] <= 0.0
+                && self.emission[j] <= 0.0
+        };
+        let rho_area: f64 = (0..n)
+            .filter(|&j| !dark(j))
+            .map(|j| self.rho[j] * self.area[j])
             .sum::<f64>()
             .max(f64::MIN_POSITIVE);
-        let n = self.area.len();
         let (mut err, mut b) = (Vec::with_capacity(n), Vec::with_capacity(n));
         for j in 0..n {
             let g = books.gathered[j].max(0.0);
@@ -128,7 +136,11 @@ impl Estimator<'_> {
             let var = self.rho[j] * self.energy_per_ray * (g - gc).max(0.0) + vc;
             let sigma = var.sqrt() / self.area[j];
             let bj = self.emission[j] + g / self.area[j];
-            let missing = self.rho[j] * owed / rho_area;
+            let missing = if dark(j) {
+                0.0
+            } else {
+                self.rho[j] * owed / rho_area
+            };
             err.push((missing * missing + std::f64::consts::FRAC_2_PI * sigma * sigma).sqrt());
             // The estimate of the true B includes what is still owed.
             b.push(bj + missing);
@@ -175,6 +187,7 @@ mod tests {
             rho: &[0.5],
             energy_per_ray: 0.01,
             rho_mean: 0.5,
+            twinned: &[],
         };
         // 100 hits of 0.01 W kept at ρ = 0.5: G = 0.5, Var = 0.5·0.01·0.5, σ/B = 0.1.
         let books = Books {
@@ -199,5 +212,34 @@ mod tests {
             ..books
         });
         assert!((m.weighted_percent - 2.0 / 3.0).abs() < 1e-12, "{m:?}");
+    }
+
+    #[test]
+    fn an_unlit_side_of_a_two_sided_surface_is_owed_nothing() {
+        // Patch 1 is the unlit back of patch 0: it takes no share of the owed light, so the
+        // estimate is patch 0's alone (as if the back were not there).
+        let est = Estimator {
+            area: &[1.0, 1.0],
+            emission: &[0.0, 0.0],
+            rho: &[0.5, 0.5],
+            energy_per_ray: 0.0,
+            rho_mean: 0.5,
+            twinned: &[true, true],
+        };
+        let books = Books {
+            gathered: &[0.5, 0.0],
+            cube_gathered: &[],
+            cube_var: &[],
+            kept: 0.5,
+            unshot: 1.0,
+            shot: 1.0,
+        };
+        let m = est.metrics(&books);
+        assert!((m.weighted_percent - 2.0 / 3.0).abs() < 1e-12, "{m:?}");
+        let (_, b) = est.per_patch(&books);
+        assert_eq!(b[1], 0.0);
+        // One-sided, the unlit patch is owed half the light.
+        let m = Estimator { twinned: &[], ..est }.metrics(&books);
+        assert!(m.weighted_percent > 0.7, "{m:?}");
     }
 }

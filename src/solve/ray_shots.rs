@@ -36,16 +36,19 @@ const ESCAPED: u32 = u32::MAX;
 /// A patch hit N times has a relative sampling error of about 1/√N, so a typical patch should
 /// be hit 1/τ² times. All shots together move about Φ_emit / (1 − ρ̄) (every bounce keeps ρ̄),
 /// spread over n patches, so C = Φ_emit·τ² / (n·(1 − ρ̄)) — about n/τ² rays in all, whatever ρ̄.
+/// n and ρ̄ count surfaces, not back twins (docs/design.md §7): making a model two-sided adds
+/// patches that mostly face the void, and must not change the sampling of the room.
 pub fn energy_per_ray(mesh: &Mesh, rho: &[[f64; 3]], emitted: f64, tolerance: f64) -> f64 {
-    let area = mesh.total_area().max(f64::MIN_POSITIVE);
-    let rho_mean: f64 = mesh
-        .patches
-        .iter()
-        .zip(rho)
-        .map(|(p, r)| scalar(r) * p.area)
+    let surfaces = || (0..mesh.patches.len()).filter(|&i| mesh.is_surface(i));
+    let area = surfaces()
+        .map(|i| mesh.patches[i].area)
+        .sum::<f64>()
+        .max(f64::MIN_POSITIVE);
+    let rho_mean: f64 = surfaces()
+        .map(|i| scalar(&rho[i]) * mesh.patches[i].area)
         .sum::<f64>()
         / area;
-    let n = mesh.patches.len().max(1) as f64;
+    let n = surfaces().count().max(1) as f64;
     emitted * tolerance * tolerance / (n * (1.0 - rho_mean).max(1e-3))
 }
 
@@ -159,12 +162,14 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         };
         // A ray leaving its own (planar, convex) patch cannot meet it again; if rounding says
         // otherwise, step past it.
+        // The shooter's surface: a back twin's rays leave the surface its front patch is.
+        let own = self.mesh.surface_of(shooter);
         for _ in 0..3 {
             match self.isect.intersect(&ray) {
                 None => return ESCAPED,
-                Some(h) if h.patch as usize == shooter => ray.tnear = h.t + eps,
-                Some(h) if h.back => return h.patch | BACK,
-                Some(h) => return h.patch,
+                Some(h) if h.patch as usize == own => ray.tnear = h.t + eps,
+                // The side met decides the receiver (docs/design.md §7).
+                Some(h) => return self.mesh.receiver(h.patch, h.back).unwrap_or(h.patch | BACK),
             }
         }
         ESCAPED

@@ -14,6 +14,7 @@ pub fn quad(s: &mut Scene, pts: [Vec3; 4], material: u32) {
         first,
         len: 4,
         material,
+        back_material: None,
     });
 }
 

@@ -25,15 +25,21 @@ pub struct SceneArgs {
     /// Longest patch edge in metres (default: derived from the scene, and printed).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     pub patch_size: Option<f32>,
-    /// Give every polygon a back patch of its own (thin surfaces lit from both sides).
+    /// Make every polygon two-sided: a back patch of its own, lit from behind (thin surfaces;
+    /// models with mixed winding). Lights still shine from their front only.
     #[arg(long)]
     pub two_sided: bool,
+    /// Turn every polygon round: for models wound clockwise (rooms inside out, lights facing
+    /// away from them).
+    #[arg(long)]
+    pub flip: bool,
 }
 
 impl SceneArgs {
     pub fn load(&self) -> LoadOptions {
         LoadOptions {
             emit: self.emit.clone(),
+            flip: self.flip,
         }
     }
     pub fn mesh(&self) -> MeshOptions {

@@ -65,6 +65,7 @@ impl PlaneMerge {
             .patches
             .iter()
             .enumerate()
+            .filter(|&(i, _)| mesh.is_surface(i)) // back twins are not surfaces (§7)
             .filter_map(|(i, p)| match p.class {
                 PatchClass::Axial(axis) => {
                     let a = axis as usize;

@@ -160,7 +160,7 @@ impl SkewEdges {
         let mut segs = Vec::new();
         let mut normals = Vec::new();
         for (i, p) in mesh.patches.iter().enumerate() {
-            if p.class == PatchClass::Skew {
+            if p.class == PatchClass::Skew && mesh.is_surface(i) {
                 let ring = mesh.patch_indices(i);
                 for k in 0..ring.len() {
                     let a = mesh.vertices[ring[k] as usize].as_dvec3();

@@ -2,7 +2,7 @@
 //! tables against a binary search.
 
 use super::*;
-use crate::mesh::{Axis, Mesh, Patch, PatchClass};
+use crate::mesh::{Axis, Mesh, Patch, PatchClass, Side};
 use glam::{vec3, Vec3};
 
 /// Two unit quads side by side in z = 0 (sharing the edge x = 1), facing +z.
@@ -24,6 +24,7 @@ fn two_quads() -> Mesh {
         centre: vec3(cx, 0.5, 0.0),
         normal: Vec3::Z,
         class: PatchClass::Axial(Axis::Z),
+        side: Side::One,
     };
     Mesh {
         vertices,
@@ -93,6 +94,7 @@ fn grid_and_fan() -> Mesh {
             centre: pts[0],
             normal,
             class: PatchClass::Axial(axis),
+            side: Side::One,
         });
     };
     let g = |i: u32| i as f32 * 0.3;
@@ -195,6 +197,7 @@ fn bucket_table_finds_places_like_a_binary_search() {
             centre: vec3(0.5, 0.5, z),
             normal: Vec3::Z,
             class: PatchClass::Axial(Axis::Z),
+            side: Side::One,
         });
     }
     let pm = PlaneMerge::build(&m);

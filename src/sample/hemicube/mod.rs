@@ -118,11 +118,13 @@ impl Hemicube {
         (self.min_ff, self.max_ff)
     }
 
-    /// Renders every patch of `mesh` except `shooter` as seen from `eye` in `frame` (frame.n =
-    /// the shooter's normal; the top face looks along n, the sides along ±t, ±b) into a z-buffer
-    /// holding the nearest patch id per cell, and writes
-    /// into `out` (cleared first), sorted by patch id, (patch id, F = Σ ΔF of its cells,
-    /// seen_from_back) for every patch with F > 0. Returns the work it did, counted (the
+    /// Renders every surface patch of `mesh` except `shooter`'s surface as seen from `eye` in
+    /// `frame` (frame.n = the shooter's normal; the top face looks along n, the sides along ±t,
+    /// ±b) into a z-buffer holding the nearest patch id per cell, and writes into `out`
+    /// (cleared first) (receiver, F = Σ ΔF of its cells, lost_on_back) for every surface with
+    /// F > 0, in surface id order. The receiver is the side the eye sees ([`Mesh::receiver`]):
+    /// the surface, its back twin, or for the back of a one-sided surface the surface itself
+    /// with `lost_on_back` set. Returns the work it did, counted (the
     /// hybrid's cost model weighs these counts, Sec. 4).
     ///
     /// With `jitter`, every cell's sample point is drawn uniformly inside its cell (the paper's
@@ -161,8 +163,10 @@ impl Hemicube {
         // Patches in the shooter's own plane (z ≈ 0 up to f32 rounding of coordinates of this
         // size) and edge-on ones must not be drawn.
         let eps = 1e-5 * (1.0 + eye.abs().max_element());
+        // Surfaces only: a back twin is drawn as its front patch (docs/design.md §7).
+        let own = mesh.surface_of(shooter);
         for j in 0..mesh.patches.len() {
-            if j == shooter {
+            if j == own || !mesh.is_surface(j) {
                 continue;
             }
             work.patches += 1;

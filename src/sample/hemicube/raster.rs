@@ -169,7 +169,13 @@ impl Hemicube {
             let f = std::mem::take(&mut acc[j as usize]);
             let p = &mesh.patches[j as usize];
             if f > 0.0 {
-                out.push((j, f, p.normal.dot(eye - p.centre) < 0.0));
+                // The side the eye sees decides the receiver: a back twin, or (one-sided) lost
+                // on the back face (docs/design.md §7).
+                let back = p.normal.dot(eye - p.centre) < 0.0;
+                out.push(match mesh.receiver(j, back) {
+                    Some(r) => (r, f, false),
+                    None => (j, f, true),
+                });
             }
         }
     }

@@ -3,7 +3,7 @@
 
 use super::grid::{side_corner_ff, top_corner_ff};
 use super::*;
-use crate::mesh::{newell, Patch, PatchClass};
+use crate::mesh::{newell, Patch, PatchClass, Side};
 use rand::SeedableRng;
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::PI;
@@ -28,6 +28,7 @@ fn quad_mesh(quads: &[(Vec3, Vec3, Vec3)]) -> Mesh {
             centre: c,
             normal: n.normalize(),
             class: PatchClass::Skew,
+            side: Side::One,
         });
     }
     mesh

@@ -48,6 +48,9 @@ pub struct LoadOptions {
     /// `(material, [r, g, b])`: set the emitted radiance `Ke` (W/sr/m², the unit of MTL `Ke`)
     /// of every material of that name. A name that matches no material is an error.
     pub emit: Vec<(String, [f64; 3])>,
+    /// Turn every polygon round (`--flip`): for models wound clockwise, whose rooms come out
+    /// inside out (docs/design.md §7).
+    pub flip: bool,
 }
 
 /// A scene that cannot be loaded. Displays as one line, `"<file>: <what is wrong>"`.
@@ -99,7 +102,8 @@ pub fn load_obj_from_strs(
 }
 
 /// Loads a scene from OBJ text: the pre-pass, tobj's parse, the materials, the geometry and
-/// its checks, `--emit` and the patch-size comment, in that order (so in that order of errors).
+/// its checks, `--emit` and the patch-size comment, in that order (so in that order of errors);
+/// then `--flip` and the merge of coincident faces.
 fn load(name: &str, text: &str, mtl: MtlSource, opts: &LoadOptions) -> Result<Scene, SceneError> {
     let fail = |message: String| SceneError::new(name, message);
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
@@ -117,6 +121,11 @@ fn load(name: &str, text: &str, mtl: MtlSource, opts: &LoadOptions) -> Result<Sc
     apply_emit(&mut scene.materials, &opts.emit).map_err(fail)?;
     scene.patch_size_hint = patch_size_hint(text).map_err(fail)?;
     scene.warnings = warnings;
+    // Sides (docs/design.md §7): `--flip`, then doubled faces merged into two-sided ones.
+    if opts.flip {
+        super::sides::flip(&mut scene);
+    }
+    scene.merged = super::sides::merge_coincident(&mut scene);
     Ok(scene)
 }
 
@@ -339,6 +348,7 @@ fn append_mesh(scene: &mut Scene, mesh: &tobj::Mesh, material: u32) -> Result<()
             first,
             len: arity,
             material,
+            back_material: None,
         });
         start = end;
     }

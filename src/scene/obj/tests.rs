@@ -207,6 +207,7 @@ fn light_area_and_emission() {
 fn emit_sets_the_named_material() {
     let opts = LoadOptions {
         emit: vec![("white".into(), [1.0, 2.0, 3.0])],
+        ..LoadOptions::default()
     };
     let scene = default_scene(&opts).unwrap();
     assert_eq!(material(&scene, "white").ke, [1.0, 2.0, 3.0]);
@@ -214,6 +215,7 @@ fn emit_sets_the_named_material() {
     // Turning the light off leaves a scene without emitter: not this loader's concern.
     let opts = LoadOptions {
         emit: vec![("light".into(), [0.0; 3])],
+        ..LoadOptions::default()
     };
     let scene = default_scene(&opts).unwrap();
     assert!(!scene.has_emitter());
@@ -223,6 +225,7 @@ fn emit_sets_the_named_material() {
 fn emit_unknown_material_is_an_error_listing_the_materials() {
     let opts = LoadOptions {
         emit: vec![("lamp".into(), [1.0; 3])],
+        ..LoadOptions::default()
     };
     assert_error(
         default_scene(&opts),
@@ -236,6 +239,7 @@ fn emit_negative_or_nan_is_an_error() {
     for ke in [[-1.0, 0.0, 0.0], [f64::NAN, 1.0, 1.0]] {
         let opts = LoadOptions {
             emit: vec![("light".into(), ke)],
+            ..LoadOptions::default()
         };
         assert_error(
             default_scene(&opts),
@@ -340,7 +344,8 @@ fn zero_area_faces_are_dropped_with_one_warning() {
         Polygon {
             first: 3,
             len: 4,
-            material: 0
+            material: 0,
+            back_material: None,
         }
     );
     assert_eq!(scene.indices.len(), 7);
