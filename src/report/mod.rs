@@ -45,6 +45,10 @@ pub struct SceneInfo {
     pub suggested_patch_size: f32,
     pub axial_fraction_count: f64,
     pub axial_fraction_area: f64,
+    /// Back twins among the patches (two-sided surfaces, docs/design.md §7).
+    pub back_patches: usize,
+    /// Doubled faces merged into two-sided ones, and repeats dropped, at load time.
+    pub merged: crate::scene::sides::Merged,
     pub total_area: f64,
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
@@ -109,6 +113,8 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
         suggested_patch_size: suggested,
         axial_fraction_count: fc,
         axial_fraction_area: fa,
+        back_patches: mesh.back_twins(),
+        merged: scene.merged,
         total_area: mesh.total_area(),
         bounds_min: lo.to_array(),
         bounds_max: hi.to_array(),
@@ -145,6 +151,11 @@ impl std::fmt::Display for SceneInfo {
             "axis-aligned   {:.1} % of patches, {:.1} % of area",
             100.0 * self.axial_fraction_count,
             100.0 * self.axial_fraction_area
+        )?;
+        writeln!(
+            f,
+            "sides          {} back patches; {} doubled faces merged into two-sided ones, {} repeated faces dropped",
+            self.back_patches, self.merged.two_sided, self.merged.repeated
         )?;
         writeln!(f, "surface area   {:.4} m²", self.total_area)?;
         let (lo, hi) = (self.bounds_min, self.bounds_max);

@@ -239,7 +239,11 @@ mod tests {
         let (_, b) = est.per_patch(&books);
         assert_eq!(b[1], 0.0);
         // One-sided, the unlit patch is owed half the light.
-        let m = Estimator { twinned: &[], ..est }.metrics(&books);
+        let m = Estimator {
+            twinned: &[],
+            ..est
+        }
+        .metrics(&books);
         assert!(m.weighted_percent > 0.7, "{m:?}");
     }
 }

@@ -169,7 +169,12 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
                 None => return ESCAPED,
                 Some(h) if h.patch as usize == own => ray.tnear = h.t + eps,
                 // The side met decides the receiver (docs/design.md §7).
-                Some(h) => return self.mesh.receiver(h.patch, h.back).unwrap_or(h.patch | BACK),
+                Some(h) => {
+                    return self
+                        .mesh
+                        .receiver(h.patch, h.back)
+                        .unwrap_or(h.patch | BACK)
+                }
             }
         }
         ESCAPED
