@@ -386,7 +386,7 @@ impl Builder {
 
     /// Cuts one planar convex polygon into patches no longer than the patch size.
     fn add_polygon(&mut self, pts: &[Vec3], material: u32, polygon: u32) {
-        let n = newell(&pts).normalize_or_zero();
+        let n = newell(pts).normalize_or_zero();
         if n == Vec3::ZERO {
             return;
         }
@@ -398,7 +398,7 @@ impl Builder {
                     .map(|k| (pts[(k + 1) % 3] - pts[k]).length())
                     .fold(0.0, f32::max);
                 let k = div(longest);
-                self.add_subdivided_triangle(&pts, k, n, material, polygon);
+                self.add_subdivided_triangle(pts, k, n, material, polygon);
             }
             4 => {
                 let along_u = (pts[1] - pts[0]).length().max((pts[2] - pts[3]).length());
