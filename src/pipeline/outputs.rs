@@ -148,6 +148,7 @@ fn summary(
         energy_per_ray: sol.stats.energy_per_ray,
         stop_fraction: s.stop_fraction,
         stop_reason: sol.stats.stop_reason,
+        error_target: sol.stats.error_target,
         shots: sol.stats.shots,
         rays: sol.stats.rays,
         waves: sol.stats.waves,

@@ -254,6 +254,8 @@ pub struct Summary {
     pub energy_per_ray: f64,
     pub stop_fraction: f64,
     pub stop_reason: Option<StopReason>,
+    /// With `--error`: the target, the estimate reached, whether it was, and the passes.
+    pub error_target: Option<crate::solve::passes::ErrorTarget>,
     pub shots: u64,
     pub rays: u64,
     pub waves: u64,
@@ -331,6 +333,17 @@ impl Summary {
                 stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
             );
         }
-        line + &format!(" in {:.2} s", stats.seconds)
+        line += &format!(" in {:.2} s", stats.seconds);
+        if let Some(t) = &stats.error_target {
+            line += &format!(
+                "; error target {:.2} % {} after {} pass{} (estimate {:.2} %)",
+                100.0 * t.target,
+                if t.reached { "reached" } else { "NOT reached" },
+                t.passes,
+                if t.passes == 1 { "" } else { "es" },
+                100.0 * t.estimate
+            );
+        }
+        line
     }
 }

@@ -81,17 +81,17 @@ pub fn shoot_with<I: Intersector>(
 }
 
 /// Per-patch scalars of the solver's error estimate.
-struct PatchScalars {
-    area: Vec<f64>,
-    emission: Vec<f64>,
-    rho: Vec<f64>,
+pub(super) struct PatchScalars {
+    pub(super) area: Vec<f64>,
+    pub(super) emission: Vec<f64>,
+    pub(super) rho: Vec<f64>,
     rho_mean: f64,
     /// Sides of two-sided surfaces (empty if the mesh has none).
     twinned: Vec<bool>,
 }
 
 impl PatchScalars {
-    fn new(mesh: &Mesh, materials: &[Material]) -> PatchScalars {
+    pub(super) fn new(mesh: &Mesh, materials: &[Material]) -> PatchScalars {
         let material = |p: &crate::mesh::Patch| &materials[p.material as usize];
         let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
         let rho: Vec<f64> = mesh
@@ -118,7 +118,7 @@ impl PatchScalars {
         }
     }
 
-    fn estimator(&self, energy_per_ray: f64) -> Estimator<'_> {
+    pub(super) fn estimator(&self, energy_per_ray: f64) -> Estimator<'_> {
         Estimator {
             area: &self.area,
             emission: &self.emission,

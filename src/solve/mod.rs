@@ -35,6 +35,7 @@ pub mod driver;
 pub mod estimate;
 pub mod gathering;
 pub mod lights;
+pub mod passes;
 pub mod ray_shots;
 pub mod settings;
 pub mod stopping;
@@ -134,6 +135,8 @@ pub struct SolveStats {
     pub hemicube_cells: u64,
     /// For `adaptive-hybrid`: when and why it switched from the hemi-cube to rays.
     pub switch: Option<SwitchInfo>,
+    /// With `--error`: the target, the estimate reached, and the passes it took.
+    pub error_target: Option<passes::ErrorTarget>,
 }
 
 /// The hemi-cube → rays switch of `adaptive-hybrid` (Sec. 4), with the costs it compared (see
@@ -261,7 +264,10 @@ pub fn run<I: Intersector>(
             }
             Ok(gathering::gather(mesh, materials, cfg, hooks, on_trace))
         }
-        _ => driver::shoot(mesh, materials, isect, cfg, hooks, on_trace),
+        _ => match cfg.error_target {
+            Some(e) => passes::shoot_to(mesh, materials, isect, cfg, hooks, e, on_trace),
+            None => driver::shoot(mesh, materials, isect, cfg, hooks, on_trace),
+        },
     }
 }
 

@@ -132,6 +132,9 @@ pub struct SolveSettings {
     pub max_time: Option<f64>,
     /// Stop after about this many form-factor samples (rays plus hemi-cube cells).
     pub max_rays: Option<u64>,
+    /// Keep refining (independent passes, averaged) until the solver's estimate of the average
+    /// weighted percent error is at most this fraction (`--error`; see [`super::passes`]).
+    pub error_target: Option<f64>,
     /// Place each ray uniformly inside its polar cell (default) rather than at its centre.
     pub jitter: bool,
     /// Resolution N of the uniform hemi-cube (the `hemicube` methods and gathering).
@@ -156,6 +159,7 @@ impl Default for SolveSettings {
             stop_fraction: DEFAULT_STOP,
             max_time: None,
             max_rays: None,
+            error_target: None,
             jitter: true,
             hemicube_n: DEFAULT_HEMICUBE_N,
             gather_cap_mib: DEFAULT_GATHER_CAP_MIB,
@@ -223,6 +227,16 @@ impl SolveSettings {
                 return Invalid::err(format!(
                     "--max-time must be a positive number of seconds, got {t}"
                 ));
+            }
+        }
+        if let Some(e) = self.error_target {
+            if !(e > 0.0 && e < 1.0) {
+                return Invalid::err(format!(
+                    "--error must be a fraction between 0 and 1 (0.02 = 2 %), got {e}"
+                ));
+            }
+            if self.method == MethodKind::Gathering {
+                return Invalid::err("--error applies to the shooting methods, not gathering");
             }
         }
         if self.max_rays == Some(0) {

@@ -120,6 +120,11 @@ pub struct SolverArgs {
     /// Stop after about this many form-factor samples (rays, plus hemi-cube cells).
     #[arg(long)]
     pub max_rays: Option<u64>,
+    /// Keep refining until the solver's own estimate of the average weighted percent error is at
+    /// most this fraction (0.02 = 2 %), or --max-time/--max-rays stops it: independent passes,
+    /// averaged, so the error keeps falling for as long as the run is allowed.
+    #[arg(long = "error", value_name = "FRACTION", allow_negative_numbers = true)]
+    pub error_target: Option<f64>,
     /// How form factors are sampled.
     #[arg(long, value_enum, default_value_t = Method::AdaptiveHybrid)]
     pub method: Method,
@@ -156,6 +161,7 @@ impl SolverArgs {
             method: self.method.into(),
             max_time: self.max_time,
             max_rays: self.max_rays,
+            error_target: self.error_target,
             switch_at: self.switch_at,
             switch_by: self.switch_by.into(),
             ..self.sampling.over(SolveSettings::default())

@@ -1,0 +1,91 @@
+//! Issue 13, item 4: `--error E` keeps refining (independent passes, averaged) until the
+//! solver's own estimate is at most E; the true error falls with it; budgets stop it; the books
+//! close and the result is reproducible.
+
+use radiosity::intersect::embree::EmbreeScene;
+use radiosity::mesh::{self, Mesh, MeshOptions};
+use radiosity::scene::{self, LoadOptions, Scene};
+use radiosity::solve::{self, estimate, Solution, SolveSettings, StopReason};
+use std::path::Path;
+
+fn load(file: &str) -> (Scene, Mesh) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(file);
+    let s = scene::load_obj(&path, &LoadOptions::default()).unwrap();
+    let m = mesh::build(&s, &MeshOptions::default());
+    (s, m)
+}
+
+fn run(s: &Scene, m: &Mesh, cfg: &SolveSettings) -> Solution {
+    let isect = EmbreeScene::build(m, |_| true).unwrap();
+    let sol = solve::solve(m, &s.materials, &isect, cfg, |_| {}).unwrap();
+    assert!(
+        sol.stats.energy.relative_residual() < 1e-9,
+        "{:?}",
+        sol.stats.energy
+    );
+    sol
+}
+
+fn estimate_of(sol: &Solution) -> f64 {
+    sol.stats.trace.last().unwrap().estimate.weighted_percent
+}
+
+#[test]
+fn the_target_is_reached_and_the_true_error_falls_with_it() {
+    let (s, m) = load("blocks.obj");
+    let area: Vec<f64> = m.patches.iter().map(|p| p.area).collect();
+    let reference = run(&s, &m, &SolveSettings::reference(99));
+    let plain = run(&s, &m, &SolveSettings::default());
+    let e0 = estimate_of(&plain);
+    let target = e0 / 2.5;
+    let cfg = SolveSettings {
+        error_target: Some(target),
+        ..SolveSettings::default()
+    };
+    let refined = run(&s, &m, &cfg);
+    let t = refined.stats.error_target.unwrap();
+    assert!(t.reached && t.estimate <= target && t.passes >= 2, "{t:?}");
+    assert!((estimate_of(&refined) - t.estimate).abs() < 1e-12);
+    let true_plain = estimate::against(&area, &plain.b, &reference.b).weighted_percent;
+    let true_refined = estimate::against(&area, &refined.b, &reference.b).weighted_percent;
+    assert!(
+        true_refined < 0.7 * true_plain,
+        "true error {true_plain} → {true_refined} (estimates {e0} → {})",
+        t.estimate
+    );
+    // The estimate stays honest: within a factor of 2 of the true error.
+    assert!(t.estimate < 2.0 * true_refined && true_refined < 2.0 * t.estimate);
+    // Reproducible.
+    assert_eq!(run(&s, &m, &cfg).b, refined.b);
+}
+
+#[test]
+fn a_budget_stops_the_refinement_and_says_so() {
+    let (s, m) = load("blocks.obj");
+    let plain = run(&s, &m, &SolveSettings::default());
+    let first = plain.stats.rays + plain.stats.hemicube_cells;
+    let cfg = SolveSettings {
+        error_target: Some(1e-4),
+        max_rays: Some(4 * first),
+        ..SolveSettings::default()
+    };
+    let sol = run(&s, &m, &cfg);
+    let t = sol.stats.error_target.unwrap();
+    assert!(!t.reached, "{t:?}");
+    assert_eq!(sol.stats.stop_reason, Some(StopReason::MaxRays));
+    assert!(t.estimate < estimate_of(&plain), "{t:?}");
+}
+
+#[test]
+fn a_bad_target_is_refused() {
+    for e in [0.0, -0.1, 1.0, f64::NAN] {
+        let cfg = SolveSettings {
+            error_target: Some(e),
+            ..SolveSettings::default()
+        };
+        let msg = cfg.check().unwrap_err().to_string();
+        assert!(msg.contains("--error"), "{msg}");
+    }
+}
