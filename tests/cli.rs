@@ -265,7 +265,7 @@ fn flipped_normals_are_reported() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(
-        err.contains("back faces") && err.contains("flipped"),
+        err.contains("back of one-sided faces") && err.contains("--two-sided"),
         "{err}"
     );
     let json: serde_json::Value =
@@ -277,7 +277,7 @@ fn flipped_normals_are_reported() {
         .as_array()
         .unwrap()
         .iter()
-        .any(|w| w.as_str().unwrap().contains("flipped")));
+        .any(|w| w.as_str().unwrap().contains("--two-sided")));
 }
 
 /// Every `--method` solves the blocks scene from the command line and says what it did; the

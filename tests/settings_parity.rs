@@ -34,6 +34,7 @@ const BAD: &[(&[&str], &[&str])] = &[
         &["--max-rays", "0"],
         &["sweep", "bench-shots", "bench-rays"],
     ),
+    (&["--error", "2"], &["sweep", "bench-shots", "bench-rays"]),
     (
         &["--method", "adaptive-rays", "--switch-at", "3"],
         &["sweep", "bench-shots", "bench-rays"],

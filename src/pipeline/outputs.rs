@@ -28,12 +28,15 @@ pub struct Run<'a> {
 /// Share of the emitted light lost on back faces above which a solve warns: a consistently
 /// wound model loses none, so 1 % already means faces wound the wrong way.
 pub const BACK_WARNING: f64 = 0.01;
-/// Share of the emitted light escaping the model above which a solve warns (open models, such
-/// as a courtyard, lose some light to the sky legitimately; most of it means lights turned out).
+/// Share of the emitted light escaping the model above which a solve warns, if the lights'
+/// backs see the model (open models, such as a courtyard, lose light to the sky legitimately).
 pub const ESCAPE_WARNING: f64 = 0.5;
 
 /// Warnings about a solution a user should hear of.
-fn solution_warnings(energy: &EnergyReport) -> Vec<String> {
+///
+/// `backs_meet`: of rays from the lights' backs, the share meeting a surface
+/// ([`crate::solve::lights::backs_meeting_surfaces`]; asked only when most light escaped).
+fn solution_warnings(energy: &EnergyReport, backs_meet: f64) -> Vec<String> {
     let mut w = Vec::new();
     // docs/design.md §7: a model with wrong winding never gives a silent black image.
     if energy.back_fraction > BACK_WARNING {
@@ -42,7 +45,7 @@ fn solution_warnings(energy: &EnergyReport) -> Vec<String> {
             100.0 * energy.back_fraction
         ));
     }
-    if energy.escaped_fraction > ESCAPE_WARNING {
+    if energy.escaped_fraction > ESCAPE_WARNING && backs_meet >= 0.5 {
         w.push(format!(
             "{:.1} % of the emitted light left the model without meeting a surface: if the lights face away from the rooms (faces wound clockwise), solve with --flip",
             100.0 * energy.escaped_fraction
@@ -90,14 +93,20 @@ pub fn write(
     }
 
     let energy = EnergyReport::from(&sol.stats.energy);
-    for w in solution_warnings(&energy) {
+    let backs_meet = match run.isect {
+        Some((isect, _)) if energy.escaped_fraction > ESCAPE_WARNING => {
+            crate::solve::lights::backs_meeting_surfaces(m, &scene.materials, isect)
+        }
+        _ => 0.0,
+    };
+    for w in solution_warnings(&energy, backs_meet) {
         log(&format!("warning: {w}"));
     }
     let warnings: Vec<String> = scene
         .warnings
         .iter()
         .cloned()
-        .chain(solution_warnings(&energy))
+        .chain(solution_warnings(&energy, backs_meet))
         .collect();
     let json = job.out.join("summary.json");
     outputs.push(json.display().to_string());

@@ -127,3 +127,48 @@ pub fn groups(scene: &Scene, mesh: &Mesh, by: GroupBy) -> LightGroups {
         .collect();
     LightGroups { names, of_patch }
 }
+
+/// Of rays leaving the lights' *backs* (up to [`FACING_PATCHES`] emitting surface patches, 16
+/// rays each on the polar grid, about each patch's centre), the share that meets any surface.
+/// docs/design.md §7: when most of the emitted light escapes a model, this tells lights turned
+/// out of a closed model (their backs see the rooms: most such rays meet something) from an
+/// open model lit on purpose (their backs see the sky). 0 when nothing emits.
+pub fn backs_meeting_surfaces<I: crate::intersect::Intersector>(
+    mesh: &Mesh,
+    materials: &[crate::scene::Material],
+    isect: &I,
+) -> f64 {
+    use crate::intersect::Ray;
+    use crate::sample::{polar::PolarGrid, Frame};
+    let lights: Vec<usize> = (0..mesh.patches.len())
+        .filter(|&i| {
+            mesh.is_surface(i) && materials[mesh.patches[i].material as usize].is_emitter()
+        })
+        .collect();
+    if lights.is_empty() {
+        return 0.0;
+    }
+    let step = lights.len().div_ceil(FACING_PATCHES);
+    let grid = PolarGrid::for_samples(16.0);
+    let mut rng = super::rng_for(0, 0, 0);
+    let (mut met, mut cast) = (0usize, 0usize);
+    for &i in lights.iter().step_by(step) {
+        let p = &mesh.patches[i];
+        let frame = Frame::new(-p.normal, 0.0);
+        let eps = 1e-4 * (p.area as f32).sqrt().max(1e-3);
+        for k in 0..grid.len() {
+            let ray = Ray {
+                org: p.centre - p.normal * eps,
+                dir: frame.to_world(grid.direction(k, 0.0, false, &mut rng)),
+                tnear: 0.0,
+                tfar: f32::INFINITY,
+            };
+            cast += 1;
+            met += usize::from(matches!(isect.intersect(&ray), Some(h) if h.patch as usize != i));
+        }
+    }
+    met as f64 / cast as f64
+}
+
+/// How many light patches [`backs_meeting_surfaces`] samples at most.
+pub const FACING_PATCHES: usize = 256;

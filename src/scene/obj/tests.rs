@@ -412,8 +412,8 @@ fn mtl_files_load_beside_the_obj() {
     let path = dir.path().join("model.obj");
     std::fs::write(
         &path,
-        "mtllib a.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
-         usemtl lamp\nf 1 2 3\nusemtl wall\nf 1 3 2\n",
+        "mtllib a.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n\
+         usemtl lamp\nf 1 2 3\nusemtl wall\nf 2 4 3\n",
     )
     .unwrap();
     std::fs::write(
@@ -551,8 +551,8 @@ fn negative_or_non_finite_reflectance_is_an_error() {
 
 #[test]
 fn reflectance_of_one_or_more_is_clamped_with_one_warning() {
-    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n\
-               usemtl white\nf 1 2 3\nusemtl hot\nf 1 3 2\nusemtl fine\nf 2 1 3\n";
+    let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\n\
+               usemtl white\nf 1 2 3\nusemtl hot\nf 2 4 3\nusemtl fine\nf 1 2 5\n";
     let mtl = "newmtl white\nKd 1 1 1\nnewmtl hot\nKd 1.5 0.5 0.25\nnewmtl fine\nKd 0.5 0.5 0.5\n";
     let scene = load_strs(obj, mtl).unwrap();
     assert_eq!(material(&scene, "white").rho, [MAX_REFLECTANCE; 3]);
