@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+from PIL import Image
 
 MAX_REFLECTANCE = 0.98
 DEFAULT_GREY = 0.5
@@ -99,10 +100,6 @@ def srgb_to_linear(v):
 def texture_mean(path: Path):
     """The mean colour of an image in linear light (integer texels read as sRGB, float linear),
     or None when it does not load."""
-    try:
-        from PIL import Image
-    except ImportError:
-        return None
     try:
         img = Image.open(path)
         img.load()
