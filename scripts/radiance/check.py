@@ -16,7 +16,7 @@ carries the weight (patches in its stratum / sampled in it), so the figures esti
 scene's. Emitters and patches with a channel of rho = 0 (no irradiance from B) are left out.
 
     .venv-radiance/bin/python scripts/radiance/check.py scenes/office.obj --out out/check/office
-    .venv-radiance/bin/python scripts/radiance/check.py MODEL.obj --solve-args "--two-sided"
+    .venv-radiance/bin/python scripts/radiance/check.py MODEL.obj --solve-args=--two-sided
 
 Writes DIR/report.json (settings, figures, every sampled patch) and prints a short table. Exit
 code 1 only when something fails to run (the figures never make it fail).
