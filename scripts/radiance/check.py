@@ -1,0 +1,489 @@
+#!/usr/bin/env python3
+"""Check a radiosity solve against Radiance on the same model, patch by patch.
+
+1. ``radiosity solve MODEL --out DIR/solve --save DIR/solve/solution.rad [--solve-args]``, then
+   ``radiosity export`` to a PLY (one face per patch, in patch order) for the patch polygons;
+   the tool's irradiance per patch is (B - E) / rho from ``patches.csv``.
+2. The same OBJ/MTL written as a Radiance scene (``objrad.py``: ``plastic`` with the tool's rho,
+   ``light`` with radiance Ke), ``oconv``, and ``rtrace -I`` at stratified points inside each
+   sampled patch, looking along its normal (Radiance's irradiance, W/m^2, averaged over the
+   points). Emitters that also reflect (rho > 0, as in the project's scenes) get the radiance
+   Ke + rho H / pi, H their irradiance found by Radiance itself in a few passes.
+3. Compared on luminance-weighted irradiance Y = 0.2126 R + 0.7152 G + 0.0722 B.
+
+Patches are sampled at random (seeded), stratified by area so small parts are represented; each
+carries the weight (patches in its stratum / sampled in it), so the figures estimate the whole
+scene's. Emitters and patches with a channel of rho = 0 (no irradiance from B) are left out.
+
+    .venv-radiance/bin/python scripts/radiance/check.py scenes/office.obj --out out/check/office
+    .venv-radiance/bin/python scripts/radiance/check.py MODEL.obj --solve-args=--two-sided
+
+Writes DIR/report.json (settings, figures, every sampled patch) and prints a short table. Exit
+code 1 only when something fails to run (the figures never make it fail).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import objrad  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+LUMA = np.array([0.2126, 0.7152, 0.0722])
+STRATA = 8
+
+
+# --------------------------------------------------------------------------------------------
+# Tools.
+
+
+def radiance_env():
+    """(bin folder, environment with RAYPATH) of the pyradiance wheel's Radiance."""
+    import pyradiance
+
+    pkg = Path(pyradiance.__file__).parent
+    env = dict(os.environ)
+    env["RAYPATH"] = str(pkg / "lib")
+    env["PATH"] = str(pkg / "bin") + os.pathsep + env.get("PATH", "")
+    return pkg / "bin", env
+
+
+def radiosity_binary(arg: str | None) -> Path:
+    if arg:
+        return Path(arg)
+    if os.environ.get("RADIOSITY"):
+        return Path(os.environ["RADIOSITY"])
+    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    return target / "release" / "radiosity"
+
+
+def run(cmd, **kw):
+    """Run a command; on failure print its stderr and stop with exit code 1."""
+    res = subprocess.run(cmd, capture_output=True, text=True, **kw)
+    if res.returncode != 0:
+        sys.stderr.write(f"failed: {shlex.join(map(str, cmd))}\n{res.stderr}\n")
+        sys.exit(1)
+    return res
+
+
+# --------------------------------------------------------------------------------------------
+# The tool's side.
+
+
+def solve(binary: Path, model: Path, out: Path, solve_args: list[str]):
+    """Solve and export; returns (patches table, patch polygons, summary, wall seconds)."""
+    sdir = out / "solve"
+    sdir.mkdir(parents=True, exist_ok=True)
+    sol = sdir / "solution.rad"
+    t0 = time.perf_counter()
+    run([binary, "solve", model, "--out", sdir, "--save", sol, "--quiet", *solve_args])
+    wall = time.perf_counter() - t0
+    run([binary, "export", sol, "--out", sdir / "patches.ply", "--quiet"])
+    table = np.genfromtxt(sdir / "patches.csv", delimiter=",", names=True)
+    polys = read_ply_faces(sdir / "patches.ply")
+    if len(polys) != len(table):
+        sys.exit(f"PLY has {len(polys)} faces, patches.csv {len(table)} rows")
+    summary = json.loads((sdir / "summary.json").read_text())
+    return table, polys, summary, wall
+
+
+def read_ply_faces(path: Path):
+    """The faces of a binary little-endian PLY as vertex arrays."""
+    data = path.read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode().splitlines()
+    sizes = {"float": "f4", "double": "f8", "uchar": "u1", "uint": "u4", "int": "i4",
+             "char": "i1", "ushort": "u2", "short": "i2"}
+    elements, cur = [], None
+    for line in header:
+        w = line.split()
+        if w[0] == "element":
+            cur = [w[1], int(w[2]), []]
+            elements.append(cur)
+        elif w[0] == "property":
+            cur[2].append(w[1:])
+    pos = end
+    verts = None
+    faces = []
+    for name, count, props in elements:
+        if name == "vertex":
+            dt = np.dtype([(p[1], "<" + sizes[p[0]]) for p in props])
+            arr = np.frombuffer(data, dtype=dt, count=count, offset=pos)
+            pos += dt.itemsize * count
+            verts = np.stack([arr["x"], arr["y"], arr["z"]], axis=1).astype(np.float64)
+        elif name == "face":
+            (_, cnt_t, idx_t, _), = props
+            cs, isz = np.dtype(sizes[cnt_t]).itemsize, np.dtype(sizes[idx_t])
+            for _ in range(count):
+                n = int(np.frombuffer(data, dtype=sizes[cnt_t], count=1, offset=pos)[0])
+                pos += cs
+                idx = np.frombuffer(data, dtype="<" + sizes[idx_t], count=n, offset=pos)
+                pos += isz.itemsize * n
+                faces.append(verts[idx])
+    return faces
+
+
+def tool_irradiance(table):
+    """Irradiance per patch and channel, (B - E) / rho (NaN where rho = 0)."""
+    b = np.stack([table["b_r"], table["b_g"], table["b_b"]], axis=1)
+    e = np.stack([table["e_r"], table["e_g"], table["e_b"]], axis=1)
+    rho = np.stack([table["rho_r"], table["rho_g"], table["rho_b"]], axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        h = np.where(rho > 0, (b - e) / rho, np.nan)
+    return h, b, e, rho
+
+
+def sample_patches(table, n: int, seed: int):
+    """Patch ids sampled in STRATA area strata (equal patch counts), with their weights."""
+    e = np.stack([table["e_r"], table["e_g"], table["e_b"]], axis=1)
+    rho = np.stack([table["rho_r"], table["rho_g"], table["rho_b"]], axis=1)
+    eligible = np.flatnonzero((e.max(axis=1) == 0) & (rho.min(axis=1) > 0))
+    rng = np.random.default_rng(seed)
+    if n >= len(eligible):
+        return eligible, np.ones(len(eligible))
+    order = eligible[np.argsort(table["area"][eligible], kind="stable")]
+    ids, weights = [], []
+    for k, stratum in enumerate(np.array_split(order, STRATA)):
+        take = n // STRATA + (1 if k < n % STRATA else 0)
+        take = min(take, len(stratum))
+        ids.extend(rng.choice(stratum, size=take, replace=False))
+        weights.extend([len(stratum) / take] * take)
+    ids, weights = np.array(ids), np.array(weights)
+    o = np.argsort(ids)
+    return ids[o], weights[o]
+
+
+# --------------------------------------------------------------------------------------------
+# Radiance's side.
+
+
+class Radiance:
+    """rtrace -I on one octree with fixed settings."""
+
+    def __init__(self, args, workdir: Path):
+        self.bin, self.env = radiance_env()
+        self.workdir = workdir
+        self.opts = ["-h", "-I+", "-n", str(args.procs), "-ab", str(args.ab), "-ad",
+                     str(args.ad), "-as", str(args.as_), "-aa", str(args.aa), "-lr",
+                     str(args.lr), "-lw", str(args.lw), "-dt", "0", "-dc", "1", "-ds", "0.02",
+                     "-dj", "0", "-dr", "0", "-u+"]
+        self.seconds = 0.0
+        self.rays = 0
+
+    def octree(self, model, name, light_radiance=None):
+        rad = self.workdir / f"{name}.rad"
+        objrad.write_rad(model, rad, light_radiance)
+        oct_path = self.workdir / f"{name}.oct"
+        with open(oct_path, "wb") as f:
+            res = subprocess.run([self.bin / "oconv", "-f", rad], stdout=f,
+                                 stderr=subprocess.PIPE, env=self.env)
+        if res.returncode != 0:
+            sys.exit(f"oconv failed: {res.stderr.decode()}")
+        return oct_path
+
+    def irradiance(self, octree: Path, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+        """RGB irradiance at each origin on a surface facing dirs."""
+        text = "\n".join(f"{o[0]:.9g} {o[1]:.9g} {o[2]:.9g} {d[0]:.9g} {d[1]:.9g} {d[2]:.9g}"
+                         for o, d in zip(origins, dirs)) + "\n"
+        t0 = time.perf_counter()
+        res = subprocess.run([self.bin / "rtrace", *self.opts, octree], input=text,
+                             capture_output=True, text=True, env=self.env)
+        self.seconds += time.perf_counter() - t0
+        if res.returncode != 0:
+            sys.exit(f"rtrace failed: {res.stderr}")
+        vals = np.array([[float(x) for x in line.split()[:3]]
+                         for line in res.stdout.splitlines() if line.strip()])
+        if len(vals) != len(origins):
+            sys.exit(f"rtrace gave {len(vals)} values for {len(origins)} points")
+        return vals
+
+
+def points_for(polys, ids, k, seed):
+    """k stratified points per patch (rows grouped by patch) and the patch normals."""
+    rng = np.random.default_rng(seed)
+    pts, normals = [], []
+    for i in ids:
+        p = polys[i]
+        n = objrad.polygon_normal(p)
+        n = n / np.linalg.norm(n)
+        pts.append(objrad.face_points(p, k, rng))
+        normals.append(np.repeat(n[None], k, axis=0))
+    return np.concatenate(pts), np.concatenate(normals)
+
+
+def light_iteration(model, radiance: Radiance, passes: int, k: int, seed: int):
+    """Radiance per emitting face for emitters that also reflect (rho > 0): L = Ke + rho H / pi,
+    H the face's mean irradiance from the rest of the scene, found by Radiance in ``passes``
+    passes (each with the radiances of the last). Returns (radiances by face, history)."""
+    faces = [i for i in objrad.emitter_faces(model)
+             if max(model.materials[model.face_material[i]].rho) > 0]
+    if not faces:
+        return None, []
+    rng = np.random.default_rng(seed)
+    origins, dirs, owner = [], [], []
+    for i in faces:
+        p = model.vertices[model.faces[i]]
+        n = objrad.polygon_normal(p)
+        n = n / np.linalg.norm(n)
+        pts = objrad.face_points(p, k, rng)
+        origins.append(pts)
+        dirs.append(np.repeat(n[None], k, axis=0))
+        owner.extend([i] * k)
+    origins, dirs, owner = np.concatenate(origins), np.concatenate(dirs), np.array(owner)
+    radiances = {i: np.array(model.materials[model.face_material[i]].ke) for i in faces}
+    history = []
+    for step in range(passes):
+        octree = radiance.octree(model, f"lights{step}", {i: r for i, r in radiances.items()})
+        h = radiance.irradiance(octree, origins, dirs)
+        new = {}
+        for i in faces:
+            m = model.materials[model.face_material[i]]
+            mean_h = h[owner == i].mean(axis=0)
+            new[i] = np.array(m.ke) + np.array(m.rho) * mean_h / np.pi
+        change = max(float(np.max(np.abs(new[i] - radiances[i]) / np.maximum(new[i], 1e-30)))
+                     for i in faces)
+        history.append({"pass": step + 1, "max_relative_change": change})
+        radiances = new
+    return radiances, history
+
+
+# --------------------------------------------------------------------------------------------
+# Comparison.
+
+
+def weighted_median(x, w):
+    o = np.argsort(x)
+    c = np.cumsum(w[o])
+    return float(x[o][np.searchsorted(c, c[-1] / 2)])
+
+
+def figures(y_tool, y_ref, area, weight):
+    """The comparison's figures on luminance-weighted irradiance."""
+    aw = area * weight
+    lit = y_ref > 0
+    rel = np.full(len(y_ref), np.nan)
+    rel[lit] = np.abs(y_tool[lit] - y_ref[lit]) / y_ref[lit]
+    med_ref = weighted_median(y_ref, weight)
+    black = (y_tool == 0) & (y_ref > 0.01 * med_ref)
+    return {
+        "area_weighted_relative_error": float(np.sum(aw * np.abs(y_tool - y_ref))
+                                              / np.sum(aw * y_ref)),
+        "area_weighted_signed_error": float(np.sum(aw * (y_tool - y_ref)) / np.sum(aw * y_ref)),
+        "median_patch_relative_error": weighted_median(rel[lit], weight[lit]),
+        "black_where_lit": int(black.sum()),
+        "black_where_lit_area_share": float(np.sum(aw[black]) / np.sum(aw)),
+        "median_reference_irradiance_Y": med_ref,
+    }
+
+
+def material_by_rho(model, rho):
+    """Names of the materials with this rho (to name a patch's material in the report)."""
+    names = [m.name for m in model.materials
+             if not m.emits and np.allclose(m.rho, rho, rtol=2e-4, atol=1e-6)]
+    return "/".join(names) if names else "?"
+
+
+def compare_solve(label, table, summary, wall, ids, weight, y_ref, model, n_worst):
+    """One solve's figures, times and worst patches against the reference."""
+    h_tool, _, _, rho = tool_irradiance(table)
+    y_tool = h_tool[ids] @ LUMA
+    area = table["area"][ids]
+    fig = figures(y_tool, y_ref, area, weight)
+    rows = []
+    for j, i in enumerate(ids):
+        rows.append({
+            "id": int(i),
+            "centre": [float(table[c][i]) for c in ("cx", "cy", "cz")],
+            "normal": [float(table[c][i]) for c in ("nx", "ny", "nz")],
+            "area": float(area[j]),
+            "weight": float(weight[j]),
+            "material": material_by_rho(model, rho[i]),
+            "tool_Y": float(y_tool[j]),
+            "radiance_Y": float(y_ref[j]),
+            "relative_error": float(abs(y_tool[j] - y_ref[j]) / y_ref[j]) if y_ref[j] > 0
+            else None,
+        })
+    contrib = area * weight * np.abs(y_tool - y_ref)
+    rel = np.nan_to_num(np.abs(y_tool - y_ref) / np.where(y_ref > 0, y_ref, np.inf), nan=0.0)
+    return {
+        "label": label,
+        "figures": fig,
+        "times": {"tool_solve_seconds": summary["seconds"]["solve"],
+                  "tool_total_seconds": summary["seconds"]["total"],
+                  "tool_wall_seconds": wall},
+        "tool_summary": {k: summary.get(k) for k in ("patches", "rays", "shots", "stop_reason",
+                                                     "energy", "error_estimate", "warnings")},
+        "worst_by_error_share": [rows[j] for j in np.argsort(-contrib)[:n_worst]],
+        "worst_by_relative_error": [rows[j] for j in np.argsort(-rel)[:n_worst]],
+        "sampled_patches": rows,
+    }
+
+
+def parse_emit(solve_args):
+    """--emit MATERIAL=R,G,B flags among the solve's arguments."""
+    emit = {}
+    for i, a in enumerate(solve_args):
+        if a == "--emit" and i + 1 < len(solve_args):
+            name, _, val = solve_args[i + 1].rpartition("=")
+            emit[name] = tuple(float(x) for x in val.split(","))
+    return emit
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=__doc__.split("\n\n", 1)[1])
+    ap.add_argument("model", type=Path, help="OBJ file (its MTL beside it)")
+    ap.add_argument("--out", type=Path, help="output folder (default out/check/MODEL)")
+    ap.add_argument("--solve-args", default="", help="extra flags for radiosity solve, quoted")
+    ap.add_argument("--also", action="append", default=[], metavar="ARGS",
+                    help="another solve (its extra flags, quoted) checked against the same "
+                    "reference; it must mesh the same patches; repeatable")
+    ap.add_argument("--radiosity", help="the radiosity binary (default $RADIOSITY, else "
+                    "$CARGO_TARGET_DIR or target, /release/radiosity)")
+    ap.add_argument("--samples", type=int, default=1000, help="patches sampled (default 1000)")
+    ap.add_argument("--points", type=int, default=8, help="points per patch (default 8)")
+    ap.add_argument("--seed", type=int, default=1, help="seed of the sampling")
+    ap.add_argument("--repeat", type=int, default=2,
+                    help="Radiance runs with independent points (their spread is the reference's "
+                    "noise; the reference is their mean); default 2")
+    ap.add_argument("--ab", type=int, default=12, help="rtrace -ab (default 12)")
+    ap.add_argument("--ad", type=int, default=512, help="rtrace -ad (default 512)")
+    ap.add_argument("--as", dest="as_", type=int, default=0, help="rtrace -as (default 0)")
+    ap.add_argument("--aa", type=float, default=0.0, help="rtrace -aa (default 0: no cache)")
+    ap.add_argument("--lr", type=int, default=-12, help="rtrace -lr (default -12)")
+    ap.add_argument("--lw", type=float, default=1e-4, help="rtrace -lw (default 1e-4)")
+    ap.add_argument("--light-passes", type=int, default=3,
+                    help="passes for emitters that also reflect (default 3)")
+    ap.add_argument("--procs", type=int, default=os.cpu_count() or 1, help="rtrace -n")
+    ap.add_argument("--worst", type=int, default=10, help="worst patches listed")
+    args = ap.parse_args()
+
+    model_path = args.model.resolve()
+    out = (args.out or ROOT / "out" / "check" / model_path.stem).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    binary = radiosity_binary(args.radiosity)
+    if not binary.is_file():
+        sys.exit(f"no radiosity binary at {binary} (cargo build --release, or --radiosity)")
+
+    # The tool: the first solve fixes the patches and the sample.
+    arg_sets = [shlex.split(args.solve_args)] + [shlex.split(a) for a in args.also]
+    solves = []
+    for k, solve_args in enumerate(arg_sets):
+        sub = out if k == 0 else out / f"also{k}"
+        table, polys, summary, wall = solve(binary, model_path, sub, solve_args)
+        if solves:
+            t0 = solves[0][1]
+            if len(table) != len(t0) or not np.allclose(
+                    [table[c] for c in ("cx", "cy", "cz")], [t0[c] for c in ("cx", "cy", "cz")]):
+                sys.exit(f"--also {shlex.join(solve_args)}: not the same patches as the first solve")
+        solves.append((solve_args, table, polys, summary, wall))
+    table, polys = solves[0][1], solves[0][2]
+    ids, weight = sample_patches(table, args.samples, args.seed)
+
+    # Radiance.
+    model = objrad.read_obj(model_path, parse_emit(arg_sets[0]))
+    rad = Radiance(args, out)
+    t0 = time.perf_counter()
+    light_radiance, light_history = light_iteration(model, rad, args.light_passes, 16,
+                                                    args.seed + 1000)
+    light_seconds = time.perf_counter() - t0
+    octree = rad.octree(model, "scene", light_radiance)
+    rad.seconds = 0.0
+    runs = []
+    for r in range(args.repeat):
+        pts, nrm = points_for(polys, ids, args.points, args.seed + 1 + r)
+        h = rad.irradiance(octree, pts, nrm)
+        runs.append(h.reshape(len(ids), args.points, 3).mean(axis=1))
+    radiance_seconds = rad.seconds
+    y_runs = np.array([h @ LUMA for h in runs])
+    y_ref = y_runs.mean(axis=0)
+    area = table["area"][ids]
+    aw = area * weight
+    lit = y_ref > 0
+    noise = {}
+    if args.repeat > 1:
+        # The reference's own noise: the standard error of the mean of its independent runs.
+        spread = y_runs.std(axis=0, ddof=1) / np.sqrt(args.repeat)
+        noise = {
+            "area_weighted": float(np.sum(aw * spread) / np.sum(aw * y_ref)),
+            "median_patch": weighted_median(spread[lit] / y_ref[lit], weight[lit]),
+            "run_to_run_area_weighted": float(np.sum(aw * np.abs(y_runs[0] - y_runs[1]))
+                                              / np.sum(aw * y_ref)),
+        }
+
+    # Patches dark on their front whose back Radiance sees lit: light lands behind them.
+    med = weighted_median(y_ref, weight)
+    dark = np.flatnonzero(y_ref <= 0.01 * med)
+    lit_behind = []
+    if len(dark):
+        pts, nrm = points_for(polys, ids[dark], args.points, args.seed + 99)
+        hb = rad.irradiance(octree, pts, -nrm).reshape(len(dark), args.points, 3).mean(axis=1)
+        lit_behind = [int(ids[d]) for d, y in zip(dark, hb @ LUMA) if y > 0.01 * med]
+
+    results = []
+    for k, (solve_args, tbl, _, summary, wall) in enumerate(solves):
+        res = compare_solve(" ".join(solve_args) or "(defaults)", tbl, summary, wall, ids,
+                            weight, y_ref, model, args.worst)
+        res["figures"]["dark_front_lit_back"] = len(lit_behind)
+        results.append(res)
+    report = {
+        "model": str(args.model),
+        "quantity": "irradiance Y = 0.2126 R + 0.7152 G + 0.0722 B (W/m^2); tool: (B - E)/rho",
+        "patches": int(len(table)),
+        "sampled": int(len(ids)),
+        "points_per_patch": args.points,
+        "radiance": {"rtrace": " ".join(rad.opts), "version": "pyradiance 1.3.1 (RADIANCE 6.0a)",
+                     "repeat": args.repeat, "noise": noise, "seconds": radiance_seconds,
+                     "points": int(len(ids) * args.points * args.repeat),
+                     "light_passes": light_history, "light_pass_seconds": light_seconds,
+                     "runs_Y": y_runs.tolist()},
+        "warnings": model.warnings,
+        "lit_behind_ids": lit_behind,
+        "solves": results,
+    }
+    (out / "report.json").write_text(json.dumps(report, indent=1))
+    print_table(report, out)
+
+
+def print_table(r, out):
+    """The short table: one column per solve."""
+    rad = r["radiance"]
+    print(f"{r['model']}: {r['patches']} patches, {r['sampled']} sampled x "
+          f"{r['points_per_patch']} points x {rad['repeat']} Radiance runs")
+    if rad["noise"]:
+        print(f"  Radiance noise (its mean): {100 * rad['noise']['area_weighted']:.2f} % "
+              f"area-weighted, {100 * rad['noise']['median_patch']:.2f} % median patch; "
+              f"{rad['seconds']:.1f} s for {rad['points']} points")
+    rows = [("solve", lambda s: s["label"][:24]),
+            ("area-weighted error %", lambda s: f"{100 * s['figures']['area_weighted_relative_error']:.2f}"),
+            ("  signed %", lambda s: f"{100 * s['figures']['area_weighted_signed_error']:+.2f}"),
+            ("median patch error %", lambda s: f"{100 * s['figures']['median_patch_relative_error']:.2f}"),
+            ("black where lit", lambda s: str(s["figures"]["black_where_lit"])),
+            ("dark front, lit back", lambda s: str(s["figures"]["dark_front_lit_back"])),
+            ("tool solve s", lambda s: f"{s['times']['tool_solve_seconds']:.2f}"),
+            ("tool run s (wall)", lambda s: f"{s['times']['tool_wall_seconds']:.2f}")]
+    for name, get in rows:
+        print(f"  {name:<22}" + "".join(f"{get(s):>26}" for s in r["solves"]))
+    s = r["solves"][0]
+    print(f"  worst patches of '{s['label']}' (share of the area-weighted error):")
+    print(f"    {'id':>7} {'material':<16} {'area m2':>9} {'tool Y':>9} {'Radiance':>9} {'rel':>7}")
+    for w in s["worst_by_error_share"][:5]:
+        rel = f"{100 * w['relative_error']:6.1f}%" if w["relative_error"] is not None else "   -"
+        print(f"    {w['id']:>7} {w['material'][:16]:<16} {w['area']:9.5f} {w['tool_Y']:9.4f} "
+              f"{w['radiance_Y']:9.4f} {rel:>7}")
+    print(f"  report: {out / 'report.json'}")
+
+
+if __name__ == "__main__":
+    main()
