@@ -205,7 +205,11 @@ pub fn patch_size(scene: &Scene, opts: &MeshOptions) -> f32 {
 pub fn rough_patch_count(scene: &Scene, opts: &MeshOptions) -> f64 {
     let size = patch_size(scene, opts) as f64;
     let per_polygon = |p: &crate::scene::Polygon| {
-        let sides = if back_material(scene, p, opts).is_some() { 2.0 } else { 1.0 };
+        let sides = if back_material(scene, p, opts).is_some() {
+            2.0
+        } else {
+            1.0
+        };
         let pts = polygon_points(scene, p);
         let (lo, hi) = pts
             .iter()
@@ -252,7 +256,11 @@ pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
 /// The material of a polygon's back side, if it has one (docs/design.md §7): its own (a
 /// doubled face merged at load time), else with `--two-sided` its front material — except for
 /// an emitter, whose light leaves its front only (as Radiance's `light`): a lamp stays one-sided.
-pub fn back_material(scene: &Scene, poly: &crate::scene::Polygon, opts: &MeshOptions) -> Option<u32> {
+pub fn back_material(
+    scene: &Scene,
+    poly: &crate::scene::Polygon,
+    opts: &MeshOptions,
+) -> Option<u32> {
     poly.back_material.or_else(|| {
         (opts.two_sided && !scene.materials[poly.material as usize].is_emitter())
             .then_some(poly.material)
@@ -378,7 +386,7 @@ impl Builder {
 
     /// Cuts one planar convex polygon into patches no longer than the patch size.
     fn add_polygon(&mut self, pts: &[Vec3], material: u32, polygon: u32) {
-        let n = newell(&pts).normalize_or_zero();
+        let n = newell(pts).normalize_or_zero();
         if n == Vec3::ZERO {
             return;
         }
@@ -390,7 +398,7 @@ impl Builder {
                     .map(|k| (pts[(k + 1) % 3] - pts[k]).length())
                     .fold(0.0, f32::max);
                 let k = div(longest);
-                self.add_subdivided_triangle(&pts, k, n, material, polygon);
+                self.add_subdivided_triangle(pts, k, n, material, polygon);
             }
             4 => {
                 let along_u = (pts[1] - pts[0]).length().max((pts[2] - pts[3]).length());
@@ -789,7 +797,11 @@ mod tests {
                 Side::One => panic!("patch {i} has no twin"),
             }
         }
-        assert_eq!(m.surface_triangles().count(), 8, "4 quads, 2 triangles each");
+        assert_eq!(
+            m.surface_triangles().count(),
+            8,
+            "4 quads, 2 triangles each"
+        );
         assert_eq!(m.triangles().count(), 16);
     }
 
@@ -817,7 +829,11 @@ mod tests {
         assert_eq!(m.patches.len(), 3, "lamp one-sided, the other two-sided");
         assert_eq!(m.patches[0].side, Side::One);
         assert_eq!(m.patches[2].material, 1, "the merged back material");
-        assert_eq!(build(&s, &opts(1.0)).back_twins(), 1, "merged faces need no flag");
+        assert_eq!(
+            build(&s, &opts(1.0)).back_twins(),
+            1,
+            "merged faces need no flag"
+        );
     }
 
     #[test]

@@ -128,7 +128,13 @@ mod tests {
         let twin = [Q[2], Q[1], Q[0], Q[3]];
         let mut s = scene_of(&[(&Q, 0), (&twin, 1)]);
         let m = merge_coincident(&mut s);
-        assert_eq!(m, Merged { two_sided: 1, repeated: 0 });
+        assert_eq!(
+            m,
+            Merged {
+                two_sided: 1,
+                repeated: 0
+            }
+        );
         assert_eq!(s.polygons.len(), 1);
         assert_eq!(s.polygons[0].material, 0);
         assert_eq!(s.polygons[0].back_material, Some(1));
@@ -141,7 +147,13 @@ mod tests {
         let twin = [Q[3], Q[2], Q[1], Q[0]];
         let mut s = scene_of(&[(&Q, 0), (&shifted, 0), (&Q, 1), (&twin, 1), (&twin, 0)]);
         let m = merge_coincident(&mut s);
-        assert_eq!(m, Merged { two_sided: 1, repeated: 3 });
+        assert_eq!(
+            m,
+            Merged {
+                two_sided: 1,
+                repeated: 3
+            }
+        );
         assert_eq!(s.polygons.len(), 1);
         assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
         assert!(s.warnings[0].starts_with("3 polygon(s) repeated"));
