@@ -22,15 +22,22 @@
 //!   by a random angle) returning the solved B_k − E_k of the *side* they meet
 //!   (`Mesh::receiver(hit, back)`; the back of a one-sided patch, or the void, gives 0). With
 //!   cosine-weighted directions the irradiance is the plain mean of what the rays return.
+//! - The two are combined by multiple importance sampling (the balance heuristic, Veach &
+//!   Guibas 1995): a hemisphere ray that meets an emitter's emitting side also counts its E at
+//!   its MIS weight, and a light sample counts at its own, so a patch beside a big emitter
+//!   (where 1/r² makes light samples heavy-tailed) takes that light from its hemisphere rays.
 //! - Points on patch i are stratified (Latin hypercube over an area-preserving map of the unit
 //!   square, `PatchPoints::at`), paired with the cells or emitter draws in random order.
 //! - B_i^gather = E_i + ρ_i·H_i (RGB, f64), with the scalar sample variance of the mean.
 //!
 //! **Which patches** ([`wanted`]): those whose shooting estimate is noisier than the tolerance
 //! asks of a typical patch — relative σ of the kept flux above `tolerance` (fewer than 1/τ²
-//! ray-equivalent hits; every patch that got none), and ρ > 0. Big, well-hit patches are left as
-//! they are: the gather could only add time there (the measurements are in README, "Final
-//! gather").
+//! ray-equivalent hits; every patch that got none), and ρ > 0. At the default tolerance that is
+//! nearly every patch (the tolerance is the *typical* patch's error, and most patches are
+//! darker or smaller than typical), and measured it had to be: gathering only the patches above
+//! 2τ or 4τ left the office at 4.9 % and 5.8 % mean per-patch error against 2.7 % for τ, and
+//! gathering all patches did no better than τ (README, "Final gather"). Big, well-hit patches
+//! keep their shooting value through the weights.
 //!
 //! **Combining** the two estimates of a gathered patch: inverse-variance weights (both are
 //! unbiased estimates of B_i − E_i). The gather's variance is its sample variance. The
