@@ -78,8 +78,9 @@ pub fn shoot_with<I: Intersector>(
         d.resume(snap)?;
     }
     let reason = d.run(start, &mut on_trace)?;
-    // The final gather re-estimates the patches the shooting left noisy (not after Ctrl-C).
-    let gather = (cfg.final_gather && reason != StopReason::Interrupted)
+    // The final gather re-estimates the patches the shooting left noisy (not after Ctrl-C);
+    // the hemi-cube baselines stay as they are.
+    let gather = (cfg.final_gather && cfg.method.casts_rays() && reason != StopReason::Interrupted)
         .then_some(isect)
         .flatten()
         .map(|isect| {
