@@ -27,6 +27,10 @@ const BAD: &[(&[&str], &[&str])] = &[
         &["sweep", "bench-shots", "bench-rays", "compare", "reference"],
     ),
     (
+        &["--gather-rays", "1"],
+        &["sweep", "bench-shots", "bench-rays", "compare", "reference"],
+    ),
+    (
         &["--max-time", "0"],
         &["sweep", "bench-shots", "bench-rays"],
     ),
@@ -150,6 +154,11 @@ fn help_names_the_library_defaults() {
         format!("[default: {DEFAULT_SEED}]"),
         format!("[default: {DEFAULT_HEMICUBE_N}]"),
         format!("[default: {DEFAULT_GATHER_CAP_MIB}]"),
+        format!("[default: {DEFAULT_GATHER_RAYS}]"),
+        format!(
+            "[default: {}]",
+            if DEFAULT_FINAL_GATHER { "on" } else { "off" }
+        ),
     ] {
         assert!(help.contains(&needle), "solve --help lacks {needle}");
     }

@@ -165,6 +165,7 @@ fn summary(
         hemicube_cells: sol.stats.hemicube_cells,
         hemicube_n: s.method.uses_uniform_cube().then_some(s.hemicube_n),
         switch: sol.stats.switch,
+        final_gather: sol.stats.final_gather,
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
         seconds: timings,
         energy,

@@ -268,6 +268,9 @@ pub struct Summary {
     /// `adaptive-hybrid`: the shot at which it switched from hemi-cubes to rays, and the
     /// measured costs that decided it (Sec. 4).
     pub switch: Option<SwitchInfo>,
+    /// The final gather after the shooting (patches gathered, rays, seconds, black patches
+    /// before and after), when one ran; `rays` above are the shooting's.
+    pub final_gather: Option<crate::solve::final_gather::GatherStats>,
     /// Rays cast per second of solve time.
     pub rays_per_second: f64,
     pub seconds: Timings,
@@ -333,6 +336,9 @@ impl Summary {
                 stats.rays as f64 / stats.seconds.max(1e-9) / 1e6
             );
         }
+        if let Some(g) = &stats.final_gather {
+            line += &format!(", {}", Self::gather_line(g));
+        }
         line += &format!(" in {:.2} s", stats.seconds);
         if let Some(t) = &stats.error_target {
             line += &format!(
@@ -345,5 +351,13 @@ impl Summary {
             );
         }
         line
+    }
+
+    /// What the final gather did, in a few words.
+    pub fn gather_line(g: &crate::solve::final_gather::GatherStats) -> String {
+        format!(
+            "final gather of {} patches ({} rays, {:.2} s; black patches {} → {})",
+            g.patches, g.rays, g.seconds, g.black_before, g.black_after
+        )
     }
 }

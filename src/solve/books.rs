@@ -396,6 +396,20 @@ impl State {
             .collect()
     }
 
+    /// The error estimate's parts per patch from the books as they stand (no wave in flight):
+    /// what the final gather weighs its own estimates against (`super::final_gather`).
+    pub fn estimate_parts(&self, est: &Estimator) -> super::estimate::Parts {
+        let gathered: Vec<f64> = self.patches.iter().map(|p| scalar(&p.gathered)).collect();
+        est.parts(&Books {
+            gathered: &gathered,
+            cube_gathered: &self.cube_gathered,
+            cube_var: &self.cube_var,
+            kept: gathered.iter().sum(),
+            unshot: self.patches.iter().map(|p| scalar(&p.unshot)).sum(),
+            shot: self.shot_flux,
+        })
+    }
+
     /// Moves what is still unshot into the books (at the end of a solve).
     pub fn close_books(&mut self) {
         let mut unshot = [0.0; 3];

@@ -30,6 +30,7 @@ use super::books::State;
 use super::checkpoint::{Header, Snapshot, SYNC_WAVES};
 use super::cube_shots::{self, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WAVE};
 use super::estimate::Estimator;
+use super::final_gather;
 use super::ray_shots::{
     apply_rays, energy_per_ray, grid_for, tasks_of, RayCaster, RayShot, Task, BACK, WAVE_RAYS,
 };
@@ -77,7 +78,36 @@ pub fn shoot_with<I: Intersector>(
         d.resume(snap)?;
     }
     let reason = d.run(start, &mut on_trace)?;
-    Ok(d.finish(reason, start))
+    // The final gather re-estimates the patches the shooting left noisy (not after Ctrl-C);
+    // the hemi-cube baselines stay as they are.
+    let gather = (cfg.final_gather && cfg.method.casts_rays() && reason != StopReason::Interrupted)
+        .then_some(isect)
+        .flatten()
+        .map(|isect| {
+            let est = d.scalars.estimator(d.energy_per_ray);
+            let shooting = final_gather::Shooting {
+                parts: d.st.estimate_parts(&est),
+                energy_per_ray: d.energy_per_ray,
+                tolerance: cfg.tolerance,
+            };
+            (isect, shooting)
+        });
+    let mut sol = d.finish(reason, start);
+    if let Some((isect, shooting)) = gather {
+        final_gather::apply(
+            mesh,
+            materials,
+            isect,
+            cfg.seed,
+            cfg.gather_rays,
+            hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
+            &shooting,
+            hooks.reference.as_deref().map(Vec::as_slice),
+            &mut sol,
+            &mut on_trace,
+        );
+    }
+    Ok(sol)
 }
 
 /// Per-patch scalars of the solver's error estimate.

@@ -86,6 +86,21 @@ pub struct Estimator<'a> {
     pub twinned: &'a [bool],
 }
 
+/// The estimate's parts per patch (scalar W/m²): see [`Estimator::parts`].
+pub struct Parts {
+    /// Light the unshot flux still owes the patch.
+    pub missing: Vec<f64>,
+    /// σ of the patch's sampling noise.
+    pub sigma: Vec<f64>,
+    /// The estimate of the true B: what was kept plus what is still owed.
+    pub b: Vec<f64>,
+}
+
+/// Expected |error| of a patch from its owed light and its noise σ: E|noise| = σ·sqrt(2/π).
+pub fn combine(missing: f64, sigma: f64) -> f64 {
+    (missing * missing + std::f64::consts::FRAC_2_PI * sigma * sigma).sqrt()
+}
+
 /// What the solver knows at a trace point, per patch and in total (scalar).
 pub struct Books<'a> {
     /// Flux kept so far, G_j (W).
@@ -102,6 +117,20 @@ pub struct Books<'a> {
 impl Estimator<'_> {
     /// Expected |B_j − B_j^true| per patch, and B_j, from the books.
     pub fn per_patch(&self, books: &Books) -> (Vec<f64>, Vec<f64>) {
+        let parts = self.parts(books);
+        let err = parts
+            .missing
+            .iter()
+            .zip(&parts.sigma)
+            .map(|(m, s)| combine(*m, *s))
+            .collect();
+        (err, parts.b)
+    }
+
+    /// The two parts of the estimate per patch, apart: light still owed and sampling noise
+    /// (the final gather replaces the noise of the patches it re-estimates; see
+    /// `solve::final_gather`).
+    pub fn parts(&self, books: &Books) -> Parts {
         // Light not yet shot: what it will still leave behind, spread like the light so far
         // (before any light was kept: evenly over the area, at the mean reflectance).
         let r = if books.shot > 0.0 {
@@ -125,7 +154,11 @@ impl Estimator<'_> {
             .map(|j| self.rho[j] * self.area[j])
             .sum::<f64>()
             .max(f64::MIN_POSITIVE);
-        let (mut err, mut b) = (Vec::with_capacity(n), Vec::with_capacity(n));
+        let mut parts = Parts {
+            missing: Vec::with_capacity(n),
+            sigma: Vec::with_capacity(n),
+            b: Vec::with_capacity(n),
+        };
         for j in 0..n {
             let g = books.gathered[j].max(0.0);
             let (gc, vc) = if books.cube_gathered.is_empty() {
@@ -141,11 +174,12 @@ impl Estimator<'_> {
             } else {
                 self.rho[j] * owed / rho_area
             };
-            err.push((missing * missing + std::f64::consts::FRAC_2_PI * sigma * sigma).sqrt());
+            parts.missing.push(missing);
+            parts.sigma.push(sigma);
             // The estimate of the true B includes what is still owed.
-            b.push(bj + missing);
+            parts.b.push(bj + missing);
         }
-        (err, b)
+        parts
     }
 
     /// The estimated metrics.

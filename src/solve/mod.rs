@@ -20,6 +20,8 @@
 //! - [`estimate`]: Sec. 3's error metrics, and the solver's own estimate of its error;
 //! - [`books`]: the energy books every shooting method keeps;
 //! - [`gathering`]: the traditional algorithm (full form-factor matrix, Gauss–Seidel);
+//! - [`final_gather`]: after shooting, the patches the shooting left noisy (the small ones)
+//!   gather their own light with rays, combined with the shooting's estimate by inverse variance;
 //! - [`checkpoint`], [`lights`] (per-light channels), [`settings`].
 //!
 //! **Reproducible.** The same scene, mesh, settings and seed give bit-identical results on any
@@ -33,6 +35,7 @@ pub mod checkpoint;
 pub mod cube_shots;
 pub mod driver;
 pub mod estimate;
+pub mod final_gather;
 pub mod gathering;
 pub mod lights;
 pub mod passes;
@@ -137,6 +140,8 @@ pub struct SolveStats {
     pub switch: Option<SwitchInfo>,
     /// With `--error`: the target, the estimate reached, and the passes it took.
     pub error_target: Option<passes::ErrorTarget>,
+    /// The final gather after the shooting, when one ran ([`final_gather`]).
+    pub final_gather: Option<final_gather::GatherStats>,
 }
 
 /// The hemi-cube → rays switch of `adaptive-hybrid` (Sec. 4), with the costs it compared (see

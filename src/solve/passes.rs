@@ -20,7 +20,8 @@
 //! passes' books, so they close as each pass's do.
 
 use super::driver::PatchScalars;
-use super::estimate::{self, Books, ErrorMetrics};
+use super::estimate::{self, Books, ErrorMetrics, Parts};
+use super::final_gather;
 use super::{scalar, RunHooks, Solution, SolveError, SolveSettings, StopReason, TracePoint};
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
@@ -88,8 +89,13 @@ fn pass_errors(ps: &PatchScalars, mesh: &Mesh, sol: &Solution) -> Pass {
     }
 }
 
-/// The rays-weighted mean of `sols` (the last one's shape), and its estimated metrics.
-fn combine(ps: &PatchScalars, passes: &[Pass], sols: &[Solution]) -> (Solution, ErrorMetrics) {
+/// The rays-weighted mean of `sols` (the last one's shape), its estimated metrics, and the
+/// estimate's parts per patch (for the final gather).
+fn combine(
+    ps: &PatchScalars,
+    passes: &[Pass],
+    sols: &[Solution],
+) -> (Solution, ErrorMetrics, Parts) {
     let total: f64 = passes.iter().map(|p| p.rays).sum();
     let w: Vec<f64> = passes.iter().map(|p| p.rays / total).collect();
     let n = ps.area.len();
@@ -131,27 +137,70 @@ fn combine(ps: &PatchScalars, passes: &[Pass], sols: &[Solution]) -> (Solution, 
             .map(|s| 1.0 / s.stats.energy_per_ray)
             .sum::<f64>();
     st.switch = sols[0].stats.switch;
-    let err = (0..n).map(|j| {
-        let var: f64 = passes
-            .iter()
-            .zip(&w)
-            .map(|(p, wk)| wk * wk * p.var[j])
-            .sum();
-        let owed: f64 = passes.iter().zip(&w).map(|(p, wk)| wk * p.owed[j]).sum();
-        (owed * owed + std::f64::consts::FRAC_2_PI * var).sqrt()
-    });
-    let b_est: Vec<f64> = (0..n)
+    let sigma: Vec<f64> = (0..n)
         .map(|j| {
-            scalar(&out.b[j])
-                + passes
-                    .iter()
-                    .zip(&w)
-                    .map(|(p, wk)| wk * p.owed[j])
-                    .sum::<f64>()
+            let var: f64 = passes
+                .iter()
+                .zip(&w)
+                .map(|(p, wk)| wk * wk * p.var[j])
+                .sum();
+            var.sqrt()
         })
         .collect();
+    let missing: Vec<f64> = (0..n)
+        .map(|j| passes.iter().zip(&w).map(|(p, wk)| wk * p.owed[j]).sum())
+        .collect();
+    let b_est: Vec<f64> = (0..n).map(|j| scalar(&out.b[j]) + missing[j]).collect();
+    let err = (0..n).map(|j| estimate::combine(missing[j], sigma[j]));
     let m = estimate::from_errors(&ps.area, err, &b_est);
-    (out, m)
+    let parts = Parts {
+        missing,
+        sigma,
+        b: b_est,
+    };
+    (out, m, parts)
+}
+
+/// What the run is judged by after each pass: the combined passes, through the final gather
+/// when the settings ask for one (then with the gather's rays per patch grown with the shooting's
+/// rays, `scale` = rays so far / the first pass's, so the two stay in balance).
+#[allow(clippy::too_many_arguments)]
+fn judged<I: Intersector>(
+    mesh: &Mesh,
+    materials: &[Material],
+    gather: Option<&I>,
+    cfg: &SolveSettings,
+    hooks: &RunHooks,
+    combined: (Solution, ErrorMetrics, Parts),
+    scale: f64,
+) -> (Solution, ErrorMetrics) {
+    let (mut sol, m, parts) = combined;
+    let Some(isect) = gather else {
+        return (sol, m);
+    };
+    let rays = (cfg.gather_rays as f64 * scale)
+        .round()
+        .min(super::settings::MAX_GATHER_RAYS as f64) as usize;
+    let shooting = final_gather::Shooting {
+        parts,
+        energy_per_ray: sol.stats.energy_per_ray,
+        // A patch is gathered when its shooting noise is above what the run aims at.
+        tolerance: cfg.tolerance.min(cfg.error_target.unwrap_or(f64::INFINITY)),
+    };
+    final_gather::apply(
+        mesh,
+        materials,
+        isect,
+        cfg.seed,
+        rays,
+        hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
+        &shooting,
+        hooks.reference.as_deref().map(Vec::as_slice),
+        &mut sol,
+        &mut |_| {},
+    );
+    let m = sol.stats.trace.last().map_or(m, |t| t.estimate);
+    (sol, m)
 }
 
 /// Whether a budget (time, rays, Ctrl-C) stopped a pass.
@@ -175,13 +224,37 @@ pub(super) fn shoot_to<I: Intersector>(
 ) -> Result<Solution, SolveError> {
     let start = Instant::now();
     let ps = PatchScalars::new(mesh, materials);
+    // Passes shoot; the final gather, if asked for, runs on their combination.
+    let gather = isect.filter(|_| cfg.final_gather && cfg.method.casts_rays());
+    let shoot_cfg = SolveSettings {
+        final_gather: false,
+        ..cfg.clone()
+    };
+    let cfg = &shoot_cfg;
     let first = super::driver::shoot(mesh, materials, isect, cfg, hooks, &mut on_trace)?;
     let c1 = first.stats.energy_per_ray;
     let r1 = (first.stats.rays + first.stats.hemicube_cells).max(1) as f64;
     let mut passes = vec![pass_errors(&ps, mesh, &first)];
     let mut trace = first.stats.trace.clone();
     let mut sols = vec![first];
-    let (mut out, mut m) = combine(&ps, &passes, &sols);
+    let interrupted = |s: &Solution| s.stats.stop_reason == Some(StopReason::Interrupted);
+    let gather_now = |s: &Solution| gather.filter(|_| !interrupted(s));
+    let (mut out, mut m) = judged(
+        mesh,
+        materials,
+        gather_now(&sols[0]),
+        cfg,
+        hooks,
+        combine(&ps, &passes, &sols),
+        1.0,
+    );
+    if out.stats.final_gather.is_some() {
+        // The gather's own trace point (its estimate, and the error against a reference).
+        if let Some(p) = out.stats.trace.last().copied() {
+            on_trace(&p);
+            trace.push(p);
+        }
+    }
     let later_hooks = RunHooks {
         reference: hooks.reference.clone(),
         light_groups: hooks.light_groups.clone(),
@@ -222,7 +295,16 @@ pub(super) fn shoot_to<I: Intersector>(
         }
         passes.push(pass_errors(&ps, mesh, &sol));
         sols.push(sol);
-        (out, m) = combine(&ps, &passes, &sols);
+        let scale = passes.iter().map(|p| p.rays).sum::<f64>() / r1;
+        (out, m) = judged(
+            mesh,
+            materials,
+            gather_now(&sols[sols.len() - 1]),
+            cfg,
+            hooks,
+            combine(&ps, &passes, &sols),
+            scale,
+        );
         let mut point = out.stats.trace.last().copied().unwrap_or_default();
         point.time_s = start.elapsed().as_secs_f64();
         point.shots = out.stats.shots;

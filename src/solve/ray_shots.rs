@@ -71,14 +71,14 @@ pub(super) struct RayShot {
 
 /// Draws points uniformly over the area of one convex patch: a fan triangle chosen by area,
 /// then a uniform point in it. Built once per chunk of rays, so no work per ray but the draw.
-struct PatchPoints {
+pub(super) struct PatchPoints {
     apex: Vec3,
     /// (b, c, cumulative area) of each fan triangle (apex, b, c).
     fan: Vec<(Vec3, Vec3, f32)>,
 }
 
 impl PatchPoints {
-    fn new(mesh: &Mesh, i: usize) -> PatchPoints {
+    pub(super) fn new(mesh: &Mesh, i: usize) -> PatchPoints {
         let ids = mesh.patch_indices(i);
         let v = |k: usize| mesh.vertices[ids[k] as usize];
         let apex = v(0);
@@ -90,6 +90,29 @@ impl PatchPoints {
             })
             .collect();
         PatchPoints { apex, fan }
+    }
+
+    /// The point at (u, v) of the unit square, an area-preserving map onto the patch (u picks
+    /// the fan triangle and its first barycentric coordinate), so stratified (u, v) give
+    /// stratified points (the final gather's).
+    pub(super) fn at(&self, u: f32, v: f32) -> Vec3 {
+        let total = self.fan[self.fan.len() - 1].2;
+        let x = u.clamp(0.0, 1.0) * total;
+        let k = self
+            .fan
+            .iter()
+            .position(|f| x < f.2)
+            .unwrap_or(self.fan.len() - 1);
+        let lo = if k == 0 { 0.0 } else { self.fan[k - 1].2 };
+        let w = self.fan[k].2 - lo;
+        let u1 = if w > 0.0 {
+            ((x - lo) / w).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        let (b, c) = (self.fan[k].0, self.fan[k].1);
+        let r1 = u1.sqrt();
+        self.apex * (1.0 - r1) + b * (r1 * (1.0 - v)) + c * (r1 * v)
     }
 
     #[inline]

@@ -24,6 +24,13 @@ pub const DEFAULT_STOP: f64 = 0.0006;
 pub const DEFAULT_HEMICUBE_N: usize = 100;
 /// Gathering refuses form-factor matrices above this many MiB by default.
 pub const DEFAULT_GATHER_CAP_MIB: u64 = 4096;
+/// The final gather after shooting is on by default (`--final-gather`; ray-casting methods).
+pub const DEFAULT_FINAL_GATHER: bool = true;
+/// Rays per gathered patch (`--gather-rays`): half shadow rays to the emitters, half over the
+/// hemisphere (see [`super::final_gather`]).
+pub const DEFAULT_GATHER_RAYS: usize = 256;
+/// The most rays per patch a final gather casts (`--gather-rays`; `--error` grows it).
+pub const MAX_GATHER_RAYS: usize = 1_000_000;
 /// `radiosity reference`: tolerance and stop fraction (100× the rays of a default solve).
 pub const REFERENCE_TOLERANCE: f64 = 0.005;
 pub const REFERENCE_STOP: f64 = 1e-5;
@@ -147,6 +154,11 @@ pub struct SolveSettings {
     /// default; reproducible) or from times measured during the run (not reproducible).
     /// `switch_at` overrides both.
     pub switch_by: SwitchBy,
+    /// After shooting, re-estimate the patches the shooting left noisy by gathering with
+    /// rays of their own ([`super::final_gather`]); methods that cast rays only.
+    pub final_gather: bool,
+    /// Rays per gathered patch.
+    pub gather_rays: usize,
 }
 
 impl Default for SolveSettings {
@@ -165,6 +177,8 @@ impl Default for SolveSettings {
             gather_cap_mib: DEFAULT_GATHER_CAP_MIB,
             switch_at: None,
             switch_by: SwitchBy::Counted,
+            final_gather: DEFAULT_FINAL_GATHER,
+            gather_rays: DEFAULT_GATHER_RAYS,
         }
     }
 }
@@ -246,6 +260,12 @@ impl SolveSettings {
             return Invalid::err(format!(
                 "--hemicube-n must be between 2 and 4096, got {}",
                 self.hemicube_n
+            ));
+        }
+        if !(4..=MAX_GATHER_RAYS).contains(&self.gather_rays) {
+            return Invalid::err(format!(
+                "--gather-rays must be between 4 and 1000000, got {}",
+                self.gather_rays
             ));
         }
         if self.switch_by != SwitchBy::Counted && self.method != MethodKind::AdaptiveHybrid {

@@ -11,7 +11,9 @@ use radiosity::render::{CameraSpec, RenderOptions, ViewSettings};
 use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
 use radiosity::solve::lights::GroupBy;
-use radiosity::solve::settings::{DEFAULT_GATHER_CAP_MIB, DEFAULT_HEMICUBE_N};
+use radiosity::solve::settings::{
+    DEFAULT_FINAL_GATHER, DEFAULT_GATHER_CAP_MIB, DEFAULT_GATHER_RAYS, DEFAULT_HEMICUBE_N,
+};
 use radiosity::solve::{MethodKind, SolveSettings, SwitchBy};
 use std::path::PathBuf;
 
@@ -91,6 +93,37 @@ pub struct SamplingArgs {
     /// scene whose patches are all axis-aligned.
     #[arg(long, value_enum, default_value_t = IntersectorArg::Auto)]
     pub intersector: IntersectorArg,
+    /// After shooting, the patches it left noisier than the tolerance (small ones that few or
+    /// no rays hit) gather their own light with rays: shadow rays to the lights and hemisphere
+    /// rays, weighed against the shooting's estimate (methods that cast rays).
+    #[arg(long, value_enum, default_value_t = OnOff::from(DEFAULT_FINAL_GATHER), value_name = "on|off")]
+    pub final_gather: OnOff,
+    /// Rays per gathered patch (half to the lights, half over the hemisphere).
+    #[arg(long, default_value_t = DEFAULT_GATHER_RAYS, value_name = "N")]
+    pub gather_rays: usize,
+}
+
+/// A switch flag's value (`--final-gather on|off`).
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OnOff {
+    On,
+    Off,
+}
+
+impl From<bool> for OnOff {
+    fn from(b: bool) -> OnOff {
+        if b {
+            OnOff::On
+        } else {
+            OnOff::Off
+        }
+    }
+}
+
+impl std::fmt::Display for OnOff {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(if *self == OnOff::On { "on" } else { "off" })
+    }
 }
 
 impl SamplingArgs {
@@ -104,6 +137,8 @@ impl SamplingArgs {
             jitter: base.jitter && !self.polar_centres,
             hemicube_n: self.hemicube_n,
             gather_cap_mib: self.gather_cap_mib,
+            final_gather: self.final_gather == OnOff::On,
+            gather_rays: self.gather_rays,
             ..base
         }
     }

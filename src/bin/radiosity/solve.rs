@@ -93,11 +93,16 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
         );
     } else if !a.quiet {
         outln!(
-            "{}: {} patches, {} shots, {} rays in {:.2} s; {}; energy balance residual {:.1e}; outputs in {}{}",
+            "{}: {} patches, {} shots, {} rays{} in {:.2} s; {}; energy balance residual {:.1e}; outputs in {}{}",
             summary.scene,
             summary.patches,
             summary.shots,
             summary.rays,
+            summary
+                .final_gather
+                .as_ref()
+                .map(|g| format!(", {}", radiosity::report::Summary::gather_line(g)))
+                .unwrap_or_default(),
             summary.seconds.total,
             summary.error_line(),
             summary.energy.relative_residual,
