@@ -2,7 +2,7 @@
 //! polygons on the same vertices, once each way round (SketchUp, many CAD exporters, MGF
 //! `sides 2`). Solved as written, the two race in every intersector and light lands on the wrong
 //! twin. At load time such a pair becomes one polygon with a back material
-//! ([`Polygon::back_material`]), which the mesh turns into a front patch and its back twin. A
+//! ([`Polygon::back_material`](super::Polygon::back_material)), which the mesh turns into a front patch and its back twin. A
 //! polygon repeated with the *same* winding is kept once (reported with a count).
 //!
 //! Two polygons are coincident when they have the same vertex positions (to a millionth of the
