@@ -92,7 +92,19 @@ pub fn shoot_with<I: Intersector>(
             };
             (isect, shooting)
         });
+    // An error target combines passes by their shooting results and exact estimates.
+    let keep = cfg.error_target.map(|_| {
+        let est = d.scalars.estimator(d.energy_per_ray);
+        d.st.estimate_parts(&est)
+    });
     let mut sol = d.finish(reason, start);
+    if let Some(parts) = keep {
+        sol.shooting = Some(Box::new(super::ShotResult {
+            b: sol.b.clone(),
+            channels: sol.channels.clone(),
+            parts,
+        }));
+    }
     if let Some((isect, shooting)) = gather {
         final_gather::apply(
             mesh,
@@ -568,6 +580,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             unshot: st.patches.iter().map(|p| p.unshot).collect(),
             stats,
             channels,
+            shooting: None,
         }
     }
 }

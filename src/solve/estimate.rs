@@ -87,6 +87,7 @@ pub struct Estimator<'a> {
 }
 
 /// The estimate's parts per patch (scalar W/m²): see [`Estimator::parts`].
+#[derive(Clone, Debug)]
 pub struct Parts {
     /// Light the unshot flux still owes the patch.
     pub missing: Vec<f64>,

@@ -349,6 +349,7 @@ pub fn gather(
         unshot: vec![[0.0; 3]; n],
         stats,
         channels,
+        shooting: None,
     }
 }
 

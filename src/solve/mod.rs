@@ -188,6 +188,17 @@ pub struct Solution {
     /// Per light group, the radiosity with only that light on (empty unless asked for); they
     /// sum to `b` (to rounding).
     pub channels: Vec<LightChannel>,
+    /// With an error target: the shooting's own result before any final gather, and its error
+    /// estimate's parts per patch, for [`passes`] to combine passes by (`None` otherwise).
+    pub shooting: Option<Box<ShotResult>>,
+}
+
+/// A shooting pass's radiosity (before any final gather) and its error estimate's parts.
+#[derive(Clone, Debug)]
+pub struct ShotResult {
+    pub b: Vec<[f64; 3]>,
+    pub channels: Vec<LightChannel>,
+    pub parts: estimate::Parts,
 }
 
 /// One light group's radiosity per patch (W/m², RGB): a *light* channel (`--per-light`), as

@@ -26,6 +26,10 @@ pub const DEFAULT_HEMICUBE_N: usize = 100;
 pub const DEFAULT_GATHER_CAP_MIB: u64 = 4096;
 /// The final gather after shooting is on by default (`--final-gather`; ray-casting methods).
 pub const DEFAULT_FINAL_GATHER: bool = true;
+/// `radiosity solve`'s error target with the ray methods (`--error`; [`super::passes`]): 5 %
+/// average weighted error, where patch-to-patch noise no longer shows as mottling on a wall.
+/// The library's [`SolveSettings::default`] has none (one pass, as the paper).
+pub const DEFAULT_ERROR_TARGET: f64 = 0.05;
 /// Rays per gathered patch (`--gather-rays`): half shadow rays to the emitters, half over the
 /// hemisphere (see [`super::final_gather`]).
 pub const DEFAULT_GATHER_RAYS: usize = 256;

@@ -11,6 +11,7 @@ use radiosity::render::{CameraSpec, RenderOptions, ViewSettings};
 use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
 use radiosity::solve::lights::GroupBy;
+use radiosity::solve::settings::DEFAULT_ERROR_TARGET;
 use radiosity::solve::settings::{
     DEFAULT_FINAL_GATHER, DEFAULT_GATHER_CAP_MIB, DEFAULT_GATHER_RAYS, DEFAULT_HEMICUBE_N,
 };
@@ -157,9 +158,11 @@ pub struct SolverArgs {
     pub max_rays: Option<u64>,
     /// Keep refining until the solver's own estimate of the average weighted percent error is at
     /// most this fraction (0.02 = 2 %), or --max-time/--max-rays stops it: independent passes,
-    /// averaged, so the error keeps falling for as long as the run is allowed.
-    #[arg(long = "error", value_name = "FRACTION", allow_negative_numbers = true)]
-    pub error_target: Option<f64>,
+    /// averaged, so the error keeps falling for as long as the run is allowed. `off`: one pass,
+    /// stopped by --tolerance's sampling alone. [default for `solve` with adaptive-hybrid or
+    /// adaptive-rays: 0.05; off otherwise]
+    #[arg(long = "error", value_name = "FRACTION|off", value_parser = parse_error_target, allow_negative_numbers = true)]
+    pub error_target: Option<ErrorTarget>,
     /// How form factors are sampled.
     #[arg(long, value_enum, default_value_t = Method::AdaptiveHybrid)]
     pub method: Method,
@@ -172,6 +175,23 @@ pub struct SolverArgs {
     /// machine; the result then varies from run to run).
     #[arg(long, value_enum, default_value_t = SwitchByArg::Counted)]
     pub switch_by: SwitchByArg,
+}
+
+/// `--error`: a fraction, or `off`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ErrorTarget {
+    Off,
+    At(f64),
+}
+
+fn parse_error_target(s: &str) -> Result<ErrorTarget, String> {
+    match s {
+        "off" | "none" => Ok(ErrorTarget::Off),
+        _ => s
+            .parse::<f64>()
+            .map(ErrorTarget::At)
+            .map_err(|_| format!("expected a fraction such as 0.02, or off; got '{s}'")),
+    }
 }
 
 /// `--switch-by`: see `radiosity::solve::SwitchBy`.
@@ -191,12 +211,33 @@ impl From<SwitchByArg> for SwitchBy {
 }
 
 impl SolverArgs {
+    /// The settings, with no error target unless `--error` gives one.
     pub fn settings(&self) -> SolveSettings {
+        self.settings_with_error(None)
+    }
+
+    /// The settings of `radiosity solve`: without `--error`, the ray methods refine to
+    /// [`DEFAULT_ERROR_TARGET`].
+    pub fn solve_settings(&self) -> SolveSettings {
+        let method: MethodKind = self.method.into();
+        let casts_rays = matches!(
+            method,
+            MethodKind::AdaptiveHybrid | MethodKind::AdaptiveRays
+        );
+        self.settings_with_error(casts_rays.then_some(DEFAULT_ERROR_TARGET))
+    }
+
+    fn settings_with_error(&self, default: Option<f64>) -> SolveSettings {
+        let error_target = match self.error_target {
+            None => default,
+            Some(ErrorTarget::Off) => None,
+            Some(ErrorTarget::At(e)) => Some(e),
+        };
         SolveSettings {
             method: self.method.into(),
             max_time: self.max_time,
             max_rays: self.max_rays,
-            error_target: self.error_target,
+            error_target,
             switch_at: self.switch_at,
             switch_by: self.switch_by.into(),
             ..self.sampling.over(SolveSettings::default())

@@ -65,7 +65,7 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
         settings: RunSettings {
             load: a.scene_args.load(),
             mesh: a.scene_args.mesh(),
-            solve: a.solve_args.settings(),
+            solve: a.solve_args.solve_settings(),
             intersector: a.solve_args.intersector(),
             per_light: a.per_light.then_some(a.light_groups.into()),
         },
