@@ -96,6 +96,15 @@ impl Mesh {
         }
     }
 
+    /// The other side of a two-sided surface's patch `i` (its twin, or its front), if any.
+    pub fn other_side(&self, i: usize) -> Option<usize> {
+        match self.patches[i].side {
+            Side::Front { back } => Some(back as usize),
+            Side::Back { front } => Some(front as usize),
+            Side::One => None,
+        }
+    }
+
     /// How many patches are back twins.
     pub fn back_twins(&self) -> usize {
         (0..self.patches.len())

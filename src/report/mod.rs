@@ -349,6 +349,12 @@ impl Summary {
                 if t.passes == 1 { "" } else { "es" },
                 100.0 * t.estimate
             );
+            if t.gave_up {
+                line += &format!(
+                    " (the default target stops at {}× the first pass's rays: give --error to go on)",
+                    crate::solve::settings::DEFAULT_ERROR_MAX_FACTOR
+                );
+            }
         }
         line
     }

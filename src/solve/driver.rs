@@ -129,7 +129,7 @@ pub(super) struct PatchScalars {
     pub(super) rho: Vec<f64>,
     rho_mean: f64,
     /// Sides of two-sided surfaces (empty if the mesh has none).
-    twinned: Vec<bool>,
+    other_side: Vec<u32>,
 }
 
 impl PatchScalars {
@@ -141,14 +141,14 @@ impl PatchScalars {
             .iter()
             .map(|p| scalar(&material(p).rho))
             .collect();
-        let twinned = if mesh.back_twins() > 0 {
-            let side = |p: &crate::mesh::Patch| p.side != crate::mesh::Side::One;
-            mesh.patches.iter().map(side).collect()
+        let other_side = if mesh.back_twins() > 0 {
+            let other = |i: usize| mesh.other_side(i).map_or(u32::MAX, |o| o as u32);
+            (0..mesh.patches.len()).map(other).collect()
         } else {
             Vec::new()
         };
         PatchScalars {
-            twinned,
+            other_side,
             emission: mesh
                 .patches
                 .iter()
@@ -167,7 +167,7 @@ impl PatchScalars {
             rho: &self.rho,
             energy_per_ray,
             rho_mean: self.rho_mean,
-            twinned: &self.twinned,
+            other_side: &self.other_side,
         }
     }
 }

@@ -80,11 +80,17 @@ pub struct Estimator<'a> {
     pub energy_per_ray: f64,
     /// Area-weighted mean reflectance: the share of shot light kept before anything is known.
     pub rho_mean: f64,
-    /// Per patch: a side of a two-sided surface (docs/design.md §7); empty when none is. A side
-    /// that has received nothing yet is presumed to face the void (the outside of a closed
-    /// room's walls) and owed nothing; one-sided patches are always owed their share.
-    pub twinned: &'a [bool],
+    /// Per patch: the other side of its two-sided surface (docs/design.md §7), `u32::MAX` for a
+    /// one-sided patch; empty when no patch has one. A side that has received at most
+    /// [`DARK_SIDE`] of what its other side has is presumed to face the void or the inside of an
+    /// object (what reaches it leaks through cracks where parts touch): it is owed nothing and
+    /// its relative error is not counted. One-sided patches are always owed their share.
+    pub other_side: &'a [u32],
 }
+
+/// A side of a two-sided surface that has received at most this share of what its other side
+/// has is dark (see [`Estimator::other_side`]; the final gather skips it too).
+pub const DARK_SIDE: f64 = 0.01;
 
 /// The estimate's parts per patch (scalar W/m²): see [`Estimator::parts`].
 #[derive(Clone, Debug)]
@@ -145,10 +151,10 @@ impl Estimator<'_> {
         // least once, and bounced light is far more even than direct light), kept at ρ_j.
         let n = self.area.len();
         let dark = |j: usize| {
-            !self.twinned.is_empty()
-                && self.twinned[j]
-                && books.gathered[j] <= 0.0
+            let o = self.other_side.get(j).copied().unwrap_or(u32::MAX);
+            o != u32::MAX
                 && self.emission[j] <= 0.0
+                && books.gathered[j] <= DARK_SIDE * books.gathered[o as usize]
         };
         let rho_area: f64 = (0..n)
             .filter(|&j| !dark(j))
@@ -170,11 +176,14 @@ impl Estimator<'_> {
             let var = self.rho[j] * self.energy_per_ray * (g - gc).max(0.0) + vc;
             let sigma = var.sqrt() / self.area[j];
             let bj = self.emission[j] + g / self.area[j];
-            let missing = if dark(j) {
-                0.0
-            } else {
-                self.rho[j] * owed / rho_area
-            };
+            if dark(j) {
+                // Presumed dark: no error counted, left out of the relative metrics (B = 0).
+                parts.missing.push(0.0);
+                parts.sigma.push(0.0);
+                parts.b.push(0.0);
+                continue;
+            }
+            let missing = self.rho[j] * owed / rho_area;
             parts.missing.push(missing);
             parts.sigma.push(sigma);
             // The estimate of the true B includes what is still owed.
@@ -222,7 +231,7 @@ mod tests {
             rho: &[0.5],
             energy_per_ray: 0.01,
             rho_mean: 0.5,
-            twinned: &[],
+            other_side: &[],
         };
         // 100 hits of 0.01 W kept at ρ = 0.5: G = 0.5, Var = 0.5·0.01·0.5, σ/B = 0.1.
         let books = Books {
@@ -259,7 +268,7 @@ mod tests {
             rho: &[0.5, 0.5],
             energy_per_ray: 0.0,
             rho_mean: 0.5,
-            twinned: &[true, true],
+            other_side: &[1, 0],
         };
         let books = Books {
             gathered: &[0.5, 0.0],
@@ -275,7 +284,7 @@ mod tests {
         assert_eq!(b[1], 0.0);
         // One-sided, the unlit patch is owed half the light.
         let m = Estimator {
-            twinned: &[],
+            other_side: &[],
             ..est
         }
         .metrics(&books);

@@ -415,14 +415,23 @@ pub fn apply<I: Intersector>(
             .count() as u64
     };
     let black_before = black(&sol.b);
+    // A side of a two-sided surface that the shooting left dark while its other side is lit
+    // faces the void or the inside of an object (docs/design.md §7): nothing to gather there.
+    let faces_void = |i: usize| {
+        mesh.other_side(i).is_some_and(|o| {
+            let other = reflected(&sol.b, o);
+            other > 0.0 && reflected(&sol.b, i) <= estimate::DARK_SIDE * other
+        })
+    };
     let todo: Vec<usize> = (0..np)
         .filter(|&i| {
-            wanted(
-                scalar(&rho[i]),
-                reflected(&sol.b, i),
-                shooting.parts.sigma[i],
-                shooting.tolerance,
-            )
+            !faces_void(i)
+                && wanted(
+                    scalar(&rho[i]),
+                    reflected(&sol.b, i),
+                    shooting.parts.sigma[i],
+                    shooting.tolerance,
+                )
         })
         .collect();
     // Emitters by scalar power; a back twin emits from the back of its surface.

@@ -46,6 +46,8 @@ pub struct ErrorTarget {
     pub reached: bool,
     /// Independent shooting passes averaged.
     pub passes: u32,
+    /// Stopped by the default target's bound ([`super::settings::DEFAULT_ERROR_MAX_FACTOR`]).
+    pub gave_up: bool,
 }
 
 /// Samples (rays and hemi-cube cells) of a solve.
@@ -225,10 +227,18 @@ pub(super) fn shoot_to<I: Intersector>(
         resume: None,
         interrupt: hooks.interrupt.clone(),
     };
+    let mut capped = false;
     while m.weighted_percent > target && !budget_stopped(&sols[sols.len() - 1]) {
         let so_far: f64 = sols.iter().map(samples).sum();
+        if cfg.error_max_factor.is_some_and(|f| so_far >= f * r1) {
+            capped = true;
+            break;
+        }
         let want = so_far * ((m.weighted_percent / target).powi(2) - 1.0);
-        let rays = want.clamp(r1, 3.0 * so_far);
+        let mut rays = want.clamp(r1, 3.0 * so_far);
+        if let Some(f) = cfg.error_max_factor {
+            rays = rays.min((f * r1 - so_far).max(r1));
+        }
         let elapsed = start.elapsed().as_secs_f64();
         let used = so_far as u64;
         let next = SolveSettings {
@@ -282,6 +292,7 @@ pub(super) fn shoot_to<I: Intersector>(
         estimate: m.weighted_percent,
         reached: m.weighted_percent <= target,
         passes: sols.len() as u32,
+        gave_up: capped,
     });
     Ok(out)
 }

@@ -30,6 +30,9 @@ pub const DEFAULT_FINAL_GATHER: bool = true;
 /// average weighted error, where patch-to-patch noise no longer shows as mottling on a wall.
 /// The library's [`SolveSettings::default`] has none (one pass, as the paper).
 pub const DEFAULT_ERROR_TARGET: f64 = 0.05;
+/// The default target gives up once passes have cast this many times the first pass's samples
+/// (so a model whose estimate falls slowly still solves in bounded time; `--error` lifts it).
+pub const DEFAULT_ERROR_MAX_FACTOR: f64 = 8.0;
 /// Rays per gathered patch (`--gather-rays`): half shadow rays to the emitters, half over the
 /// hemisphere (see [`super::final_gather`]).
 pub const DEFAULT_GATHER_RAYS: usize = 256;
@@ -146,6 +149,9 @@ pub struct SolveSettings {
     /// Keep refining (independent passes, averaged) until the solver's estimate of the average
     /// weighted percent error is at most this fraction (`--error`; see [`super::passes`]).
     pub error_target: Option<f64>,
+    /// With `error_target`: give up once the passes have cast this many times the first pass's
+    /// samples (`radiosity solve`'s default target is bounded so; an explicit `--error` is not).
+    pub error_max_factor: Option<f64>,
     /// Place each ray uniformly inside its polar cell (default) rather than at its centre.
     pub jitter: bool,
     /// Resolution N of the uniform hemi-cube (the `hemicube` methods and gathering).
@@ -176,6 +182,7 @@ impl Default for SolveSettings {
             max_time: None,
             max_rays: None,
             error_target: None,
+            error_max_factor: None,
             jitter: true,
             hemicube_n: DEFAULT_HEMICUBE_N,
             gather_cap_mib: DEFAULT_GATHER_CAP_MIB,

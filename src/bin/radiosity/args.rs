@@ -11,7 +11,7 @@ use radiosity::render::{CameraSpec, RenderOptions, ViewSettings};
 use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
 use radiosity::solve::lights::GroupBy;
-use radiosity::solve::settings::DEFAULT_ERROR_TARGET;
+use radiosity::solve::settings::{DEFAULT_ERROR_MAX_FACTOR, DEFAULT_ERROR_TARGET};
 use radiosity::solve::settings::{
     DEFAULT_FINAL_GATHER, DEFAULT_GATHER_CAP_MIB, DEFAULT_GATHER_RAYS, DEFAULT_HEMICUBE_N,
 };
@@ -160,7 +160,7 @@ pub struct SolverArgs {
     /// most this fraction (0.02 = 2 %), or --max-time/--max-rays stops it: independent passes,
     /// averaged, so the error keeps falling for as long as the run is allowed. `off`: one pass,
     /// stopped by --tolerance's sampling alone. [default for `solve` with adaptive-hybrid or
-    /// adaptive-rays: 0.05; off otherwise]
+    /// adaptive-rays: 0.05, giving up after 8× the first pass's rays; off otherwise]
     #[arg(long = "error", value_name = "FRACTION|off", value_parser = parse_error_target, allow_negative_numbers = true)]
     pub error_target: Option<ErrorTarget>,
     /// How form factors are sampled.
@@ -224,7 +224,11 @@ impl SolverArgs {
             method,
             MethodKind::AdaptiveHybrid | MethodKind::AdaptiveRays
         );
-        self.settings_with_error(casts_rays.then_some(DEFAULT_ERROR_TARGET))
+        let mut s = self.settings_with_error(casts_rays.then_some(DEFAULT_ERROR_TARGET));
+        if self.error_target.is_none() && s.error_target.is_some() {
+            s.error_max_factor = Some(DEFAULT_ERROR_MAX_FACTOR);
+        }
+        s
     }
 
     fn settings_with_error(&self, default: Option<f64>) -> SolveSettings {
