@@ -81,7 +81,12 @@ fn weighted_mean(w: &[f64], rows: &[&[[f64; 3]]]) -> Vec<[f64; 3]> {
 
 /// The samples-weighted mean of the passes' shooting results, in the shape of the last pass's
 /// solution, with the combined estimate's parts.
-fn combine(area: &[f64], sols: &[Solution]) -> (Solution, ErrorMetrics, Parts) {
+fn combine(
+    mesh: &Mesh,
+    area: &[f64],
+    emission: &[f64],
+    sols: &[Solution],
+) -> (Solution, ErrorMetrics, Parts) {
     let shot: Vec<&ShotResult> = sols
         .iter()
         .map(|s| s.shooting.as_deref().expect("passes keep their shooting"))
@@ -129,7 +134,7 @@ fn combine(area: &[f64], sols: &[Solution]) -> (Solution, ErrorMetrics, Parts) {
             .sum::<f64>();
     st.switch = sols[0].stats.switch;
     st.final_gather = None;
-    let sigma: Vec<f64> = (0..n)
+    let mut sigma: Vec<f64> = (0..n)
         .map(|j| {
             (0..sols.len())
                 .map(|k| (w[k] * shot[k].parts.sigma[j]).powi(2))
@@ -137,14 +142,25 @@ fn combine(area: &[f64], sols: &[Solution]) -> (Solution, ErrorMetrics, Parts) {
                 .sqrt()
         })
         .collect();
-    let missing: Vec<f64> = (0..n)
+    let mut missing: Vec<f64> = (0..n)
         .map(|j| {
             (0..sols.len())
                 .map(|k| w[k] * shot[k].parts.missing[j])
                 .sum()
         })
         .collect();
-    let b_est: Vec<f64> = (0..n).map(|j| scalar(&out.b[j]) + missing[j]).collect();
+    let mut b_est: Vec<f64> = (0..n).map(|j| scalar(&out.b[j]) + missing[j]).collect();
+    // The dark-side rule (estimate::DARK_SIDE) on the combination: a side that got light in one
+    // pass by a chance leak is still dark beside its lit other side.
+    let reflected = |j: usize| scalar(&out.b[j]) - emission[j];
+    for j in 0..n {
+        let dark = mesh.other_side(j).is_some_and(|o| {
+            emission[j] <= 0.0 && reflected(j) <= estimate::DARK_SIDE * reflected(o)
+        });
+        if dark {
+            (missing[j], sigma[j], b_est[j]) = (0.0, 0.0, 0.0);
+        }
+    }
     let err = (0..n).map(|j| estimate::combine(missing[j], sigma[j]));
     let m = estimate::from_errors(area, err, &b_est);
     let parts = Parts {
@@ -207,6 +223,11 @@ pub(super) fn shoot_to<I: Intersector>(
 ) -> Result<Solution, SolveError> {
     let start = Instant::now();
     let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
+    let emission: Vec<f64> = mesh
+        .patches
+        .iter()
+        .map(|p| scalar(&materials[p.material as usize].emission()))
+        .collect();
     let first = super::driver::shoot(mesh, materials, isect, cfg, hooks, &mut on_trace)?;
     let r1 = samples(&first);
     let c1 = first.stats.energy_per_ray;
@@ -263,7 +284,7 @@ pub(super) fn shoot_to<I: Intersector>(
             break;
         }
         sols.push(sol);
-        let combined = combine(&area, &sols);
+        let combined = combine(mesh, &area, &emission, &sols);
         (out, m) = match gather {
             Some(isect) => {
                 let scale = sols.iter().map(samples).sum::<f64>() / r1;
