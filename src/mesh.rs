@@ -655,6 +655,14 @@ mod tests {
     use crate::scene::{Material, Polygon};
     use glam::vec3;
 
+    /// The unit square in z = 0, facing +z.
+    const UNIT_QUAD: [Vec3; 4] = [
+        vec3(0., 0., 0.),
+        vec3(1., 0., 0.),
+        vec3(1., 1., 0.),
+        vec3(0., 1., 0.),
+    ];
+
     fn scene_of(faces: &[&[Vec3]]) -> Scene {
         let mut s = Scene {
             materials: vec![Material {
@@ -774,12 +782,7 @@ mod tests {
 
     #[test]
     fn two_sided_adds_opposite_patches_with_their_own_vertices() {
-        let quad = [
-            vec3(0., 0., 0.),
-            vec3(1., 0., 0.),
-            vec3(1., 1., 0.),
-            vec3(0., 1., 0.),
-        ];
+        let quad = UNIT_QUAD;
         let m = build(
             &scene_of(&[&quad]),
             &MeshOptions {
@@ -816,12 +819,7 @@ mod tests {
 
     #[test]
     fn an_emitter_stays_one_sided_and_a_merged_back_material_is_used() {
-        let quad = [
-            vec3(0., 0., 0.),
-            vec3(1., 0., 0.),
-            vec3(1., 1., 0.),
-            vec3(0., 1., 0.),
-        ];
+        let quad = UNIT_QUAD;
         let mut s = scene_of(&[&quad, &quad.map(|v| v + Vec3::Z)]);
         s.materials.push(Material {
             name: "lamp".into(),

@@ -3,18 +3,14 @@
 //! close and the result is reproducible.
 
 use radiosity::intersect::embree::EmbreeScene;
-use radiosity::mesh::{self, Mesh, MeshOptions};
-use radiosity::scene::{self, LoadOptions, Scene};
+use radiosity::mesh::Mesh;
+use radiosity::scene::Scene;
 use radiosity::solve::{self, estimate, Solution, SolveSettings, StopReason};
-use std::path::Path;
+
+mod common;
 
 fn load(file: &str) -> (Scene, Mesh) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(file);
-    let s = scene::load_obj(&path, &LoadOptions::default()).unwrap();
-    let m = mesh::build(&s, &MeshOptions::default());
-    (s, m)
+    common::project_scene(file)
 }
 
 fn run(s: &Scene, m: &Mesh, cfg: &SolveSettings) -> Solution {

@@ -5,19 +5,12 @@
 mod common;
 
 use radiosity::intersect::embree::EmbreeScene;
-use radiosity::mesh::{self, Mesh, MeshOptions};
-use radiosity::scene::{self, LoadOptions, Scene};
+use radiosity::mesh::Mesh;
+use radiosity::scene::Scene;
 use radiosity::solve::{self, MethodKind, Solution, SolveSettings, SwitchBy};
-use std::path::Path;
 
 fn load(file: &str) -> (Scene, Mesh) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(file);
-    let s = scene::load_obj(&path, &LoadOptions::default()).unwrap();
-    // MeshOptions::default(): the file's own `# radiosity: patch-size`.
-    let m = mesh::build(&s, &MeshOptions::default());
-    (s, m)
+    common::project_scene(file)
 }
 
 fn solve_in(threads: Option<usize>, s: &Scene, m: &Mesh, cfg: &SolveSettings) -> Solution {

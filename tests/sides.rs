@@ -49,6 +49,20 @@ fn reversed(v: &[&str]) -> String {
     face(&r)
 }
 
+/// The office with every other face turned round, lights kept: light meets the backs of
+/// one-sided faces.
+fn mixed() -> String {
+    let k = std::cell::Cell::new(0);
+    rewrite(|v, light| {
+        k.set(k.get() + 1);
+        vec![if !light && k.get() % 2 == 0 {
+            reversed(v)
+        } else {
+            face(v)
+        }]
+    })
+}
+
 fn load(obj: &str, flip: bool) -> Scene {
     let opts = LoadOptions {
         flip,
@@ -155,16 +169,7 @@ fn an_inside_out_model_warns_and_flip_fixes_it() {
 #[test]
 fn mixed_winding_warns_and_two_sided_fixes_it() {
     let (want, noise) = plain();
-    // Every other face turned round, lights kept: light meets the backs of one-sided faces.
-    let k = std::cell::Cell::new(0);
-    let mixed = rewrite(|v, light| {
-        k.set(k.get() + 1);
-        vec![if !light && k.get() % 2 == 0 {
-            reversed(v)
-        } else {
-            face(v)
-        }]
-    });
+    let mixed = mixed();
     let s = load(&mixed, false);
     let (_, sol) = solve(&s, false, 1);
     assert!(sol.stats.energy.back_fraction() > BACK_WARNING);
@@ -222,15 +227,7 @@ fn the_warnings_name_the_flag() {
         warned(&run(&rewrite(|v, _| vec![reversed(v)])), "--flip"),
         1
     );
-    let k = std::cell::Cell::new(0);
-    let mixed = rewrite(|v, light| {
-        k.set(k.get() + 1);
-        vec![if !light && k.get() % 2 == 0 {
-            reversed(v)
-        } else {
-            face(v)
-        }]
-    });
+    let mixed = mixed();
     assert_eq!(warned(&run(&mixed), "--two-sided"), 1);
     assert_eq!(
         run(OBJ).lines().filter(|l| l.contains("warning")).count(),

@@ -134,3 +134,13 @@ pub fn solve_mesh_with(
         .then(|| radiosity::intersect::embree::EmbreeScene::build(m, |_| true).unwrap());
     radiosity::solve::run(m, &scene.materials, isect.as_ref(), cfg, hooks, |_| {}).unwrap()
 }
+
+/// A scene of the project's `scenes/` folder, meshed at its own `# radiosity: patch-size`.
+pub fn project_scene(file: &str) -> (Scene, radiosity::mesh::Mesh) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(file);
+    let s = radiosity::scene::load_obj(&path, &radiosity::scene::LoadOptions::default()).unwrap();
+    let m = radiosity::mesh::build(&s, &radiosity::mesh::MeshOptions::default());
+    (s, m)
+}
