@@ -48,7 +48,8 @@ pub fn merge_coincident(scene: &mut Scene) -> Merged {
     let mut first_of: HashMap<Vec<[i64; 3]>, usize> = HashMap::new();
     let mut keep = vec![true; scene.polygons.len()];
     let mut merged = Merged::default();
-    let mut backs: Vec<(usize, u32)> = Vec::new();
+    // The back material each front polygon was given (at most one).
+    let mut back_of: HashMap<usize, u32> = HashMap::new();
     for (pi, poly) in scene.polygons.iter().enumerate() {
         let keys: Vec<[i64; 3]> = scene
             .polygon_indices(poly)
@@ -63,17 +64,17 @@ pub fn merge_coincident(scene: &mut Scene) -> Merged {
             merged.repeated += 1;
         } else if let Some(&front) = first_of.get(&backward) {
             keep[pi] = false;
-            if backs.iter().any(|&(f, _)| f == front) {
-                merged.repeated += 1;
-            } else {
-                backs.push((front, poly.material));
+            if let std::collections::hash_map::Entry::Vacant(e) = back_of.entry(front) {
+                e.insert(poly.material);
                 merged.two_sided += 1;
+            } else {
+                merged.repeated += 1;
             }
         } else {
             first_of.insert(forward, pi);
         }
     }
-    for (front, material) in backs {
+    for (front, material) in back_of {
         scene.polygons[front].back_material = Some(material);
     }
     if merged.repeated > 0 {
