@@ -348,61 +348,9 @@ def parse_emit(solve_args):
     return emit
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
-                                 formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 epilog=__doc__.split("\n\n", 1)[1])
-    ap.add_argument("model", type=Path, help="OBJ file (its MTL beside it)")
-    ap.add_argument("--out", type=Path, help="output folder (default out/check/MODEL)")
-    ap.add_argument("--solve-args", default="", help="extra flags for radiosity solve, quoted")
-    ap.add_argument("--also", action="append", default=[], metavar="ARGS",
-                    help="another solve (its extra flags, quoted) checked against the same "
-                    "reference; it must mesh the same patches; repeatable")
-    ap.add_argument("--radiosity", help="the radiosity binary (default $RADIOSITY, else "
-                    "$CARGO_TARGET_DIR or target, /release/radiosity)")
-    ap.add_argument("--samples", type=int, default=1000, help="patches sampled (default 1000)")
-    ap.add_argument("--points", type=int, default=8, help="points per patch (default 8)")
-    ap.add_argument("--seed", type=int, default=1, help="seed of the sampling")
-    ap.add_argument("--repeat", type=int, default=2,
-                    help="Radiance runs with independent points (their spread is the reference's "
-                    "noise; the reference is their mean); default 2")
-    ap.add_argument("--ab", type=int, default=12, help="rtrace -ab (default 12)")
-    ap.add_argument("--ad", type=int, default=512, help="rtrace -ad (default 512)")
-    ap.add_argument("--as", dest="as_", type=int, default=0, help="rtrace -as (default 0)")
-    ap.add_argument("--aa", type=float, default=0.0, help="rtrace -aa (default 0: no cache)")
-    ap.add_argument("--lr", type=int, default=-12, help="rtrace -lr (default -12)")
-    ap.add_argument("--lw", type=float, default=1e-4, help="rtrace -lw (default 1e-4)")
-    ap.add_argument("--light-passes", type=int, default=3,
-                    help="passes for emitters that also reflect (default 3)")
-    ap.add_argument("--procs", type=int, default=os.cpu_count() or 1, help="rtrace -n")
-    ap.add_argument("--worst", type=int, default=10, help="worst patches listed")
-    args = ap.parse_args()
 
-    model_path = args.model.resolve()
-    out = (args.out or ROOT / "out" / "check" / model_path.stem).resolve()
-    out.mkdir(parents=True, exist_ok=True)
-    binary = radiosity_binary(args.radiosity)
-    if not binary.is_file():
-        sys.exit(f"no radiosity binary at {binary} (cargo build --release, or --radiosity)")
-
-    # The tool: the first solve fixes the patches and the sample.
-    arg_sets = [shlex.split(args.solve_args)] + [shlex.split(a) for a in args.also]
-    solves = []
-    for k, solve_args in enumerate(arg_sets):
-        sub = out if k == 0 else out / f"also{k}"
-        table, polys, summary, wall = solve(binary, model_path, sub, solve_args)
-        if solves:
-            t0 = solves[0][1]
-            if len(table) != len(t0) or not np.allclose(
-                    [table[c] for c in ("cx", "cy", "cz")], [t0[c] for c in ("cx", "cy", "cz")]):
-                sys.exit(f"--also {shlex.join(solve_args)}: not the same patches as the first solve")
-        solves.append((solve_args, table, polys, summary, wall))
-    table, polys = solves[0][1], solves[0][2]
-    ids, weight = sample_patches(table, args.samples, args.seed)
-
-    # Radiance.
-    model = objrad.read_obj(model_path, parse_emit(arg_sets[0]))
-    rad = Radiance(args, out)
+def radiance_reference(args, model, rad, table, polys, ids, weight):
+    """Radiance's irradiance at the sampled patches' points: runs, noise, lit-behind ids."""
     t0 = time.perf_counter()
     light_radiance, light_history = light_iteration(model, rad, args.light_passes, 16,
                                                     args.seed + 1000)
@@ -439,6 +387,95 @@ def main():
         pts, nrm = points_for(polys, ids[dark], args.points, args.seed + 99)
         hb = rad.irradiance(octree, pts, -nrm).reshape(len(dark), args.points, 3).mean(axis=1)
         lit_behind = [int(ids[d]) for d, y in zip(dark, hb @ LUMA) if y > 0.01 * med]
+
+    return {"y_runs": y_runs.tolist(), "noise": noise, "lit_behind": lit_behind,
+            "light_history": light_history, "light_seconds": light_seconds,
+            "seconds": radiance_seconds}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=__doc__.split("\n\n", 1)[1])
+    ap.add_argument("model", type=Path, help="OBJ file (its MTL beside it)")
+    ap.add_argument("--out", type=Path, help="output folder (default out/check/MODEL)")
+    ap.add_argument("--solve-args", default="", help="extra flags for radiosity solve, quoted")
+    ap.add_argument("--also", action="append", default=[], metavar="ARGS",
+                    help="another solve (its extra flags, quoted) checked against the same "
+                    "reference; it must mesh the same patches; repeatable")
+    ap.add_argument("--radiosity", help="the radiosity binary (default $RADIOSITY, else "
+                    "$CARGO_TARGET_DIR or target, /release/radiosity)")
+    ap.add_argument("--samples", type=int, default=1000, help="patches sampled (default 1000)")
+    ap.add_argument("--points", type=int, default=8, help="points per patch (default 8)")
+    ap.add_argument("--seed", type=int, default=1, help="seed of the sampling")
+    ap.add_argument("--repeat", type=int, default=2,
+                    help="Radiance runs with independent points (their spread is the reference's "
+                    "noise; the reference is their mean); default 2")
+    ap.add_argument("--ab", type=int, default=12, help="rtrace -ab (default 12)")
+    ap.add_argument("--ad", type=int, default=512, help="rtrace -ad (default 512)")
+    ap.add_argument("--as", dest="as_", type=int, default=0, help="rtrace -as (default 0)")
+    ap.add_argument("--aa", type=float, default=0.0, help="rtrace -aa (default 0: no cache)")
+    ap.add_argument("--lr", type=int, default=-12, help="rtrace -lr (default -12)")
+    ap.add_argument("--lw", type=float, default=1e-4, help="rtrace -lw (default 1e-4)")
+    ap.add_argument("--light-passes", type=int, default=3,
+                    help="passes for emitters that also reflect (default 3)")
+    ap.add_argument("--procs", type=int, default=os.cpu_count() or 1, help="rtrace -n")
+    ap.add_argument("--reuse", action="store_true",
+                    help="reuse Radiance's result saved in --out when made for the same model, "
+                         "points and settings (to compare solver changes quickly)")
+    ap.add_argument("--worst", type=int, default=10, help="worst patches listed")
+    args = ap.parse_args()
+
+    model_path = args.model.resolve()
+    out = (args.out or ROOT / "out" / "check" / model_path.stem).resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    binary = radiosity_binary(args.radiosity)
+    if not binary.is_file():
+        sys.exit(f"no radiosity binary at {binary} (cargo build --release, or --radiosity)")
+
+    # The tool: the first solve fixes the patches and the sample.
+    arg_sets = [shlex.split(args.solve_args)] + [shlex.split(a) for a in args.also]
+    solves = []
+    for k, solve_args in enumerate(arg_sets):
+        sub = out if k == 0 else out / f"also{k}"
+        table, polys, summary, wall = solve(binary, model_path, sub, solve_args)
+        if solves:
+            t0 = solves[0][1]
+            if len(table) != len(t0) or not np.allclose(
+                    [table[c] for c in ("cx", "cy", "cz")], [t0[c] for c in ("cx", "cy", "cz")]):
+                sys.exit(f"--also {shlex.join(solve_args)}: not the same patches as the first solve")
+        solves.append((solve_args, table, polys, summary, wall))
+    table, polys = solves[0][1], solves[0][2]
+    ids, weight = sample_patches(table, args.samples, args.seed)
+
+    # Radiance, or its saved result for the same model, points and settings (--reuse).
+    model = objrad.read_obj(model_path, parse_emit(arg_sets[0]))
+    rad = Radiance(args, out)
+    key = {"model": str(model_path), "bytes": model_path.stat().st_size,
+           "mtime": model_path.stat().st_mtime, "rtrace": " ".join(rad.opts),
+           "ids": [int(i) for i in ids], "points": args.points, "seed": args.seed,
+           "repeat": args.repeat, "light_passes": args.light_passes,
+           "emit": arg_sets[0]}
+    saved = out / "radiance.json"
+    cached = None
+    if args.reuse and saved.is_file():
+        cached = json.loads(saved.read_text())
+        if cached.get("key") != key:
+            print(f"{saved}: made for other points or settings; running Radiance")
+            cached = None
+    if cached is None:
+        cached = radiance_reference(args, model, rad, table, polys, ids, weight)
+        cached["key"] = key
+        saved.write_text(json.dumps(cached))
+    else:
+        print(f"Radiance's result reused from {saved} (--reuse)")
+    y_runs = np.array(cached["y_runs"])
+    y_ref = y_runs.mean(axis=0)
+    noise = cached["noise"]
+    lit_behind = cached["lit_behind"]
+    light_history = cached["light_history"]
+    light_seconds = cached["light_seconds"]
+    radiance_seconds = cached["seconds"]
 
     results = []
     for k, (solve_args, tbl, _, summary, wall) in enumerate(solves):

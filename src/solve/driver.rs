@@ -88,7 +88,6 @@ pub fn shoot_with<I: Intersector>(
             let shooting = final_gather::Shooting {
                 parts: d.st.estimate_parts(&est),
                 energy_per_ray: d.energy_per_ray,
-                tolerance: cfg.tolerance,
             };
             (isect, shooting)
         });
@@ -111,7 +110,7 @@ pub fn shoot_with<I: Intersector>(
             materials,
             isect,
             cfg.seed,
-            cfg.gather_rays,
+            cfg.gather_rays_per_patch(),
             hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
             &shooting,
             hooks.reference.as_deref().map(Vec::as_slice),

@@ -21,7 +21,7 @@
 //! Σ w_k·owed_kj (each pass's own estimate's parts, kept by the driver in
 //! [`super::ShotResult`]), through [`estimate::from_errors`] — after the final gather when one is
 //! asked for, run on the combined shooting result with its rays per patch grown with the
-//! shooting's samples, gathering every patch noisier than E. The energy books are the
+//! shooting's samples. The energy books are the
 //! samples-weighted mean of the passes' books, so they close as each pass's do. A pass cut short
 //! by a budget is left out (its light still unshot would pull the mean down).
 
@@ -172,27 +172,24 @@ fn combine(
 }
 
 /// The combination through the final gather, when the settings ask for one: rays per patch
-/// grown by `scale` (samples so far / the first pass's) so gather and shooting stay in balance,
-/// and every patch noisier than the target gathered.
+/// grown by `scale` (samples so far / the first pass's) so gather and shooting stay in balance.
 #[allow(clippy::too_many_arguments)]
 fn gathered<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
     isect: &I,
     cfg: &SolveSettings,
-    target: f64,
     hooks: &RunHooks,
     combined: (Solution, ErrorMetrics, Parts),
     scale: f64,
 ) -> (Solution, ErrorMetrics) {
     let (mut sol, _, parts) = combined;
-    let rays = (cfg.gather_rays as f64 * scale)
+    let rays = (cfg.gather_rays_per_patch() as f64 * scale)
         .round()
         .min(super::settings::MAX_GATHER_RAYS as f64) as usize;
     let shooting = final_gather::Shooting {
         parts,
         energy_per_ray: sol.stats.energy_per_ray,
-        tolerance: cfg.tolerance.min(target),
     };
     final_gather::apply(
         mesh,
@@ -288,7 +285,7 @@ pub(super) fn shoot_to<I: Intersector>(
         (out, m) = match gather {
             Some(isect) => {
                 let scale = sols.iter().map(samples).sum::<f64>() / r1;
-                gathered(mesh, materials, isect, cfg, target, hooks, combined, scale)
+                gathered(mesh, materials, isect, cfg, hooks, combined, scale)
             }
             None => (combined.0, combined.1),
         };

@@ -167,7 +167,7 @@ pub struct SolveSettings {
     /// After shooting, re-estimate the patches the shooting left noisy by gathering with
     /// rays of their own ([`super::final_gather`]); methods that cast rays only.
     pub final_gather: bool,
-    /// Rays per gathered patch.
+    /// Rays per gathered patch at the default tolerance ([`SolveSettings::gather_rays_per_patch`]).
     pub gather_rays: usize,
 }
 
@@ -204,6 +204,17 @@ impl SolveSettings {
             stop_fraction: REFERENCE_STOP,
             ..SolveSettings::default()
         }
+    }
+
+    /// Rays each patch gathers: `gather_rays` at the default tolerance, grown as 1/τ² with a
+    /// finer one, as the shooting's rays grow (`energy_per_ray` ∝ τ²), so the gather's noise
+    /// keeps pace with the shooting's (a reference solve's gather is not left at the default's
+    /// noise); at most [`MAX_GATHER_RAYS`].
+    pub fn gather_rays_per_patch(&self) -> usize {
+        let grow = (DEFAULT_TOLERANCE / self.tolerance).powi(2).max(1.0);
+        (self.gather_rays as f64 * grow)
+            .round()
+            .min(MAX_GATHER_RAYS as f64) as usize
     }
 
     /// These settings for `method` instead: the settings that apply to one method only (the

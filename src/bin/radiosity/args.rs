@@ -94,12 +94,13 @@ pub struct SamplingArgs {
     /// scene whose patches are all axis-aligned.
     #[arg(long, value_enum, default_value_t = IntersectorArg::Auto)]
     pub intersector: IntersectorArg,
-    /// After shooting, the patches it left noisier than the tolerance (small ones that few or
-    /// no rays hit) gather their own light with rays: shadow rays to the lights and hemisphere
-    /// rays, weighed against the shooting's estimate (methods that cast rays).
+    /// After shooting, every patch gathers its own light with rays: shadow rays to the lights
+    /// and hemisphere rays (followed on through narrow gaps), weighed against the shooting's
+    /// estimate (methods that cast rays).
     #[arg(long, value_enum, default_value_t = OnOff::from(DEFAULT_FINAL_GATHER), value_name = "on|off")]
     pub final_gather: OnOff,
-    /// Rays per gathered patch (half to the lights, half over the hemisphere).
+    /// Rays per gathered patch at the default tolerance, growing as 1/tolerance² with a finer
+    /// one (half to the lights, half over the hemisphere).
     #[arg(long, default_value_t = DEFAULT_GATHER_RAYS, value_name = "N")]
     pub gather_rays: usize,
 }
