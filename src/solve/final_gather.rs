@@ -233,14 +233,7 @@ impl<I: Intersector> Ctx<'_, I> {
             for (&(u, v), &(s, t)) in here.iter().zip(&there) {
                 let x = points.at(u, v) + n * eps;
                 // Stratified choice of the emitter, then a point on it from the rest of `s`.
-                let target = s as f64 * self.power;
-                let e = self
-                    .cdf
-                    .partition_point(|&c| c <= target)
-                    .min(self.cdf.len() - 1);
-                let lo = if e == 0 { 0.0 } else { self.cdf[e - 1] };
-                let w = (self.cdf[e] - lo).max(f64::MIN_POSITIVE);
-                let s2 = (((target - lo) / w) as f32).clamp(0.0, 1.0);
+                let (e, w, s2) = self.pick_emitter(f64::from(s));
                 let j = self.emitters[e];
                 let y = self.emitter_points[e].at(s2, t);
                 let shadow = self.direct(i, j, x, y, n, eps);
@@ -335,6 +328,19 @@ impl<I: Intersector> Ctx<'_, I> {
         Gathered { h, ch, var, rays }
     }
 
+    /// The emitter (index into `emitters`) that `s` ∈ [0, 1) picks along the power CDF, its
+    /// power, and what is left of `s` within its stretch (for a point on it).
+    fn pick_emitter(&self, s: f64) -> (usize, f64, f32) {
+        let target = s * self.power;
+        let e = self
+            .cdf
+            .partition_point(|&c| c <= target)
+            .min(self.cdf.len() - 1);
+        let lo = if e == 0 { 0.0 } else { self.cdf[e - 1] };
+        let w = (self.cdf[e] - lo).max(f64::MIN_POSITIVE);
+        (e, w, (((target - lo) / w) as f32).clamp(0.0, 1.0))
+    }
+
     /// The light side `r` reflects towards a hemisphere ray that met it at `y` from distance
     /// `t` (RGB, and per channel). From afar, the solution's B_r − E_r. From nearer than r's
     /// size (√A_r · [`NEAR`]), where a constant B over r is not what this point sees (the wall
@@ -355,7 +361,8 @@ impl<I: Intersector> Ctx<'_, I> {
         let k = self.channels.len();
         let area = mesh.patches[r].area as f32;
         let rho = self.rho[r];
-        if depth >= NEAR_DEPTH || !(t < NEAR * area.sqrt()) || scalar(&rho) <= 0.0 {
+        let near = t < NEAR * area.sqrt();
+        if depth >= NEAR_DEPTH || !near || scalar(&rho) <= 0.0 {
             let own = |c: usize| self.group.is_some_and(|g| g[r] as usize == c);
             return Reflected {
                 v: [0, 1, 2].map(|q| (self.b[r][q] - self.e[r][q]).max(0.0)),
@@ -386,13 +393,7 @@ impl<I: Intersector> Ctx<'_, I> {
         };
         // One light sample.
         if nl > 0.0 {
-            let target = rng.gen::<f64>() * self.power;
-            let e = self
-                .cdf
-                .partition_point(|&c| c <= target)
-                .min(self.cdf.len() - 1);
-            let lo = if e == 0 { 0.0 } else { self.cdf[e - 1] };
-            let w = (self.cdf[e] - lo).max(f64::MIN_POSITIVE);
+            let (e, w, _) = self.pick_emitter(rng.gen());
             let j = self.emitters[e];
             let yj = self.emitter_points[e].at(rng.gen(), rng.gen());
             if let Some(sh) = self.direct(r, j, x, yj, n, eps) {
