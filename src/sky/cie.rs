@@ -14,7 +14,7 @@
 //!
 //! 0.274 is `gensky`'s rounding of f(0) = 1 − e^(−0.32) = 0.27385, so L_z is `gensky`'s zenith
 //! parameter and the clear sky's true zenith luminance is 0.99945 L_z. Below the horizon the
-//! sky is the ground (see `Sky`); the distributions here are for μ > 0 only.
+//! sky is the ground (see [`super::Sky`]); the distributions here are for μ > 0 only.
 //!
 //! The unobstructed horizontal illuminance is E_h = L_z ∫ (L / L_z) cos θ dω over the upper
 //! hemisphere, in closed form for two of them:
