@@ -39,6 +39,7 @@ pub mod sample;
 pub mod saved;
 pub mod scene;
 pub mod settings;
+pub mod sky;
 pub mod solve;
 
 pub use error::Error;

@@ -1,0 +1,314 @@
+//! Daylight: the sky and the sun as distant emitters (issue 14).
+//!
+//! This module owns the light that comes from outside the model: the sky's luminance
+//! distribution ([`cie`]: uniform, CIE overcast, CIE clear), the sun's position ([`solar`]: NOAA's
+//! algorithm) and disc ([`sun`]), the ground glow below the horizon, the model's orientation
+//! ([`frame`]) and the cut of all of it into directional pieces a shooter can fire parallel
+//! rays from ([`tregenza`], [`piece`]). It follows the conventions of Radiance's `gensky`, so a
+//! scene can be checked against Radiance:
+//!
+//! - the zenith parameter L_z is `gensky -b` (in cd/m² here, W/sr/m² there: divide by 179);
+//! - the horizontal illuminance is the sky's alone, without the sun (`gensky -B`);
+//! - solar azimuth is degrees west of south (`gensky -ang ALT AZI`);
+//! - the ground below the horizon is uniform with radiance ρ_g E_h / π, E_h the sky's plus the
+//!   sun's horizontal irradiance and ρ_g the ground reflectance (`gensky -g`, default 0.2).
+//!
+//! Departures: the horizon is sharp (`skybright.cal` blends sky into ground over a few degrees
+//! with weights (cos θ + 1.01)^±10, which lowers an overcast sky's horizontal illuminance by
+//! 0.14 % and a vertical window's by 0.3 %), so the pieces carry exactly the stated horizontal
+//! illuminance; a clear sky's sun above 87° stays where it is (`gensky` lowers it to 87°); the
+//! clear sky's E_h / L_z is integrated (`gensky -B` uses a quartic fit, 0.25 % off at worst);
+//! the sun's position is NOAA's (`gensky`'s own date formula is far coarser). To compare with
+//! Radiance, give `gensky` the angles ([`Sky::sun_position`], `-ang`) and the zenith parameter
+//! ([`Sky::zenith_luminance`] / 179, `-b`) rather than a date and `-B`. Sky and sun are white:
+//! equal RGB radiance.
+//!
+//! **Units.** Radiance is in W/sr/m² and irradiance in W/m², the solver's units; photometric
+//! values (cd/m², lux) convert by [`EFFICACY`].
+
+pub mod cie;
+pub mod frame;
+pub mod piece;
+pub mod solar;
+pub mod sun;
+pub mod tregenza;
+
+pub use cie::SkyKind;
+pub use frame::{Frame, DEFAULT_NORTH, DEFAULT_ZENITH};
+pub use piece::{PieceKind, SkyPiece};
+pub use solar::{DateTime, Site, SolarAngles};
+pub use sun::{Sun, SunLevel};
+
+use glam::{DVec3, Vec3};
+use std::f64::consts::PI;
+
+/// Luminous efficacy of white light, lm/W: luminance (cd/m²) = 179 × radiance (W/sr/m²) and
+/// illuminance (lux) = 179 × irradiance (W/m²). Radiance's convention for white light (its
+/// `rtrace -I` results are turned into lux with the same factor).
+pub const EFFICACY: f64 = 179.0;
+
+/// `gensky`'s default ground reflectance (`-g`).
+pub const DEFAULT_GROUND_REFLECTANCE: f64 = 0.2;
+
+/// The default unobstructed horizontal illuminance of the sky, lux (issue 14's overcast default).
+pub const DEFAULT_SKY_ILLUMINANCE: f64 = 10_000.0;
+
+/// How bright the sky is; either value gives the other.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SkyLevel {
+    /// The zenith parameter L_z, cd/m² (`gensky -b` × 179).
+    ZenithLuminance(f64),
+    /// Unobstructed horizontal illuminance of the sky alone, lux (`gensky -B` × 179).
+    HorizontalIlluminance(f64),
+    /// `gensky`'s default from the sun's altitude ([`cie::gensky_zenith_luminance`]).
+    Gensky,
+}
+
+/// What a sky is made of: the settings, unchecked until [`Sky::new`].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SkySpec {
+    pub kind: SkyKind,
+    pub level: SkyLevel,
+    /// Where the sun is. Needed by the clear sky, by a sun and by [`SkyLevel::Gensky`].
+    pub sun_position: Option<SolarAngles>,
+    /// Draw a sun this bright (`None`: no sun, as `gensky -s`, `-c`, `-u`).
+    pub sun: Option<SunLevel>,
+    /// ρ_g, in [0, 1].
+    pub ground_reflectance: f64,
+    /// The model's up direction (any length).
+    pub zenith: Vec3,
+    /// The model's north (any length; only its horizontal part counts).
+    pub north: Vec3,
+}
+
+impl Default for SkySpec {
+    /// An overcast sky of [`DEFAULT_SKY_ILLUMINANCE`], no sun, ρ_g = 0.2, Y up, north −Z.
+    fn default() -> SkySpec {
+        SkySpec {
+            kind: SkyKind::Overcast,
+            level: SkyLevel::HorizontalIlluminance(DEFAULT_SKY_ILLUMINANCE),
+            sun_position: None,
+            sun: None,
+            ground_reflectance: DEFAULT_GROUND_REFLECTANCE,
+            zenith: DEFAULT_ZENITH,
+            north: DEFAULT_NORTH,
+        }
+    }
+}
+
+/// A sky that cannot be built.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SkyError {
+    #[error("the {which} direction {v} is zero or not finite")]
+    BadDirection { which: &'static str, v: Vec3 },
+    #[error("north {north} is parallel to the zenith {zenith}")]
+    Parallel { zenith: Vec3, north: Vec3 },
+    #[error("the ground reflectance {0} is not within [0, 1]")]
+    BadReflectance(f64),
+    #[error("the {what} {value} is not a finite, non-negative number")]
+    BadLevel { what: &'static str, value: f64 },
+    #[error("{0} needs the sun's position (altitude and azimuth, or a site and a time)")]
+    NoSunPosition(&'static str),
+    #[error(
+        "solar altitude {altitude}° and azimuth {azimuth}°: the altitude must be within [-90, 90]"
+    )]
+    BadAngles { altitude: f64, azimuth: f64 },
+    #[error("latitude {latitude}°, longitude {longitude}° is not a place on the earth")]
+    BadSite { latitude: f64, longitude: f64 },
+    #[error("bad date and time: {0}")]
+    BadTime(String),
+}
+
+/// A sky ready to light a scene.
+#[derive(Clone, Debug)]
+pub struct Sky {
+    kind: SkyKind,
+    frame: Frame,
+    /// The sun's direction for the clear sky's distribution (local; the zenith if unused).
+    sun_local: DVec3,
+    sun_position: Option<SolarAngles>,
+    sun: Option<Sun>,
+    sun_below_horizon: bool,
+    /// L_z, W/sr/m².
+    zenith_radiance: f64,
+    /// E_h / L_z, steradians.
+    ratio: f64,
+    /// ρ_g E_h / π, W/sr/m².
+    ground_radiance: f64,
+    pieces: Vec<SkyPiece>,
+}
+
+impl Sky {
+    /// Checks `spec` and builds the sky, its sun and its pieces.
+    pub fn new(spec: &SkySpec) -> Result<Sky, SkyError> {
+        let frame = Frame::new(spec.zenith, spec.north)?;
+        check(spec)?;
+        let sun_local = spec.sun_position.map_or(DVec3::Z, |a| a.local_dir());
+        let bands = tregenza::patches();
+        // ∫ (L / L_z) cos θ dω per patch: the pieces' radiances and, summed, E_h / L_z.
+        let q: Vec<f64> = bands
+            .iter()
+            .map(|b| b.integrate(|d| spec.kind.relative(d, sun_local)))
+            .collect();
+        let ratio: f64 = q.iter().sum();
+        let zenith_radiance = zenith_radiance(spec, ratio);
+        let sun = match (spec.sun, spec.sun_position) {
+            (Some(level), Some(angles)) => Sun::new(angles, level, &frame),
+            _ => None,
+        };
+        let e_total = zenith_radiance * ratio + sun.map_or(0.0, |s| s.horizontal_irradiance());
+        let mut sky = Sky {
+            kind: spec.kind,
+            frame,
+            sun_local,
+            sun_position: spec.sun_position,
+            sun,
+            sun_below_horizon: spec.sun.is_some() && sun.is_none(),
+            zenith_radiance,
+            ratio,
+            ground_radiance: spec.ground_reflectance * e_total / PI,
+            pieces: Vec::new(),
+        };
+        sky.pieces = sky.build_pieces(&bands, &q);
+        Ok(sky)
+    }
+
+    /// Sky patches (in `tregenza.cal`'s order), then ground patches, then the sun if up.
+    fn build_pieces(&self, bands: &[tregenza::Band], q: &[f64]) -> Vec<SkyPiece> {
+        let sky = bands.iter().zip(q).enumerate().map(|(k, (b, qk))| {
+            let radiance = self.zenith_radiance * qk / b.projected_solid_angle();
+            SkyPiece::band(PieceKind::Sky, k, *b, radiance, self.frame)
+        });
+        let ground = bands.iter().enumerate().map(|(k, b)| {
+            SkyPiece::band(
+                PieceKind::Ground,
+                k,
+                b.mirrored(),
+                self.ground_radiance,
+                self.frame,
+            )
+        });
+        let sun = self.sun.iter().map(|s| SkyPiece::sun(s, self.frame));
+        sky.chain(ground).chain(sun).collect()
+    }
+
+    /// The distant emitters: 145 sky pieces, 145 ground pieces and the sun when it is up.
+    pub fn pieces(&self) -> &[SkyPiece] {
+        &self.pieces
+    }
+
+    /// The radiance (W/sr/m², RGB) a ray escaping the model towards `dir_to_sky` (any length)
+    /// meets: the sky's exact distribution above the horizon, the ground below (and for a zero
+    /// or non-finite direction). The sun is **not** included: gathers sample it explicitly
+    /// through [`Sky::sun`], as a tiny bright disc is missed by hemisphere sampling.
+    pub fn radiance(&self, dir_to_sky: Vec3) -> [f64; 3] {
+        let d = self
+            .frame
+            .to_local(dir_to_sky.as_dvec3().normalize_or_zero());
+        if d.z > 0.0 {
+            [self.zenith_radiance * self.kind.relative(d, self.sun_local); 3]
+        } else {
+            [self.ground_radiance; 3]
+        }
+    }
+
+    /// The sun, when one was asked for and it is above the horizon.
+    pub fn sun(&self) -> Option<&Sun> {
+        self.sun.as_ref()
+    }
+
+    /// Whether a sun was asked for but is below the horizon (so there is none).
+    pub fn sun_below_horizon(&self) -> bool {
+        self.sun_below_horizon
+    }
+
+    /// The sun's position as given (even below the horizon, or with no sun drawn).
+    pub fn sun_position(&self) -> Option<SolarAngles> {
+        self.sun_position
+    }
+
+    /// Unobstructed horizontal illuminance, lux: (sky, sun). Sky + sun is a daylight factor's
+    /// denominator only if the sun counts; CIE daylight factors use the overcast sky alone.
+    pub fn horizontal_illuminance(&self) -> (f64, f64) {
+        let (sky, sun) = self.horizontal_irradiance();
+        (sky * EFFICACY, sun * EFFICACY)
+    }
+
+    /// Unobstructed horizontal irradiance, W/m²: (sky, sun).
+    pub fn horizontal_irradiance(&self) -> (f64, f64) {
+        let sun = self.sun.map_or(0.0, |s| s.horizontal_irradiance());
+        (self.zenith_radiance * self.ratio, sun)
+    }
+
+    /// The zenith parameter L_z, cd/m² (`gensky -b` is this / 179).
+    pub fn zenith_luminance(&self) -> f64 {
+        self.zenith_radiance * EFFICACY
+    }
+
+    /// The ground's radiance ρ_g E_h / π, W/sr/m².
+    pub fn ground_radiance(&self) -> f64 {
+        self.ground_radiance
+    }
+
+    pub fn kind(&self) -> SkyKind {
+        self.kind
+    }
+
+    pub fn frame(&self) -> &Frame {
+        &self.frame
+    }
+}
+
+/// Refuses a spec whose numbers are out of range or which lacks a sun position it needs.
+fn check(spec: &SkySpec) -> Result<(), SkyError> {
+    let rho = spec.ground_reflectance;
+    if !(0.0..=1.0).contains(&rho) {
+        return Err(SkyError::BadReflectance(rho));
+    }
+    let level = match spec.level {
+        SkyLevel::ZenithLuminance(v) => Some(("zenith luminance", v)),
+        SkyLevel::HorizontalIlluminance(v) => Some(("sky illuminance", v)),
+        SkyLevel::Gensky => None,
+    };
+    let sun = match spec.sun {
+        Some(SunLevel::NormalIlluminance(v)) => Some(("sun's normal illuminance", v)),
+        Some(SunLevel::HorizontalIlluminance(v)) => Some(("sun's horizontal illuminance", v)),
+        _ => None,
+    };
+    for (what, value) in level.into_iter().chain(sun) {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(SkyError::BadLevel { what, value });
+        }
+    }
+    if spec.sun_position.is_none() {
+        let needs = if spec.kind.needs_sun_position() {
+            Some("the clear sky")
+        } else if spec.sun.is_some() {
+            Some("a sun")
+        } else if spec.level == SkyLevel::Gensky {
+            Some("gensky's default sky brightness")
+        } else {
+            None
+        };
+        if let Some(what) = needs {
+            return Err(SkyError::NoSunPosition(what));
+        }
+    }
+    Ok(())
+}
+
+/// L_z in W/sr/m² from the spec's level, E_h / L_z being `ratio`.
+fn zenith_radiance(spec: &SkySpec, ratio: f64) -> f64 {
+    match spec.level {
+        SkyLevel::ZenithLuminance(cd) => cd / EFFICACY,
+        SkyLevel::HorizontalIlluminance(lux) => lux / EFFICACY / ratio,
+        SkyLevel::Gensky => {
+            let altitude = spec.sun_position.map_or(90.0, |a| a.altitude);
+            cie::gensky_zenith_luminance(spec.kind, altitude) / EFFICACY
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
