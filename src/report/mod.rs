@@ -229,7 +229,9 @@ impl From<&EnergyBalance> for EnergyReport {
             balance: *b,
             relative_residual: b.relative_residual(),
             back_fraction: b.back_fraction(),
-            escaped_fraction: scalar(&b.escaped) / scalar(&b.emitted).max(f64::MIN_POSITIVE),
+            // Sky and sun rays that missed the model never entered it.
+            escaped_fraction: (scalar(&b.escaped) - scalar(&b.distant_missed)).max(0.0)
+                / (scalar(&b.emitted) - scalar(&b.distant_missed)).max(f64::MIN_POSITIVE),
         }
     }
 }

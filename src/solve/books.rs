@@ -351,6 +351,29 @@ impl State {
         add3(&mut self.energy.absorbed_back, phi);
     }
 
+    /// A distant emitter (a sky piece, the sun: [`super::sky_shots`]) shoots `phi`: emitted,
+    /// and never held unshot by a patch.
+    pub fn emit_distant(&mut self, phi: &[f64; 3]) {
+        add3(&mut self.energy.emitted, phi);
+        add3(&mut self.energy.distant, phi);
+        self.shot_flux += scalar(phi);
+    }
+
+    /// Flux from a distant emitter that arrived on a back face (absorbed there): a one-sided
+    /// model's outside, not a winding error.
+    #[inline]
+    pub fn deposit_back_distant(&mut self, phi: &[f64; 3]) {
+        add3(&mut self.energy.absorbed_back, phi);
+        add3(&mut self.energy.distant_back, phi);
+    }
+
+    /// A distant emitter's ray that missed the model.
+    #[inline]
+    pub fn escape_distant(&mut self, phi: &[f64; 3]) {
+        add3(&mut self.energy.escaped, phi);
+        add3(&mut self.energy.distant_missed, phi);
+    }
+
     /// Flux that left an open scene.
     #[inline]
     pub fn escape(&mut self, phi: &[f64; 3]) {

@@ -34,6 +34,7 @@ use super::final_gather;
 use super::ray_shots::{
     apply_rays, energy_per_ray, grid_for, tasks_of, RayCaster, RayShot, Task, BACK, WAVE_RAYS,
 };
+use super::sky_shots;
 use super::stopping::{self, Progress};
 use super::switch::{self, CostModel, SwitchPolicy};
 use super::{
@@ -43,6 +44,7 @@ use super::{
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
+use crate::sky::Sky;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -76,6 +78,8 @@ pub fn shoot_with<I: Intersector>(
     let mut d = Driver::new(mesh, materials, isect, cfg, hooks, model)?;
     if let Some(snap) = &hooks.resume {
         d.resume(snap)?;
+    } else {
+        d.shoot_sky();
     }
     let reason = d.run(start, &mut on_trace)?;
     // The final gather re-estimates the patches the shooting left noisy (not after Ctrl-C);
@@ -113,6 +117,7 @@ pub fn shoot_with<I: Intersector>(
             cfg.gather_rays_per_patch(),
             hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
             &shooting,
+            cfg.sky.as_ref().and_then(|s| Sky::new(s).ok()).as_ref(),
             hooks.reference.as_deref().map(Vec::as_slice),
             &mut sol,
             &mut on_trace,
@@ -190,6 +195,8 @@ struct Driver<'a, I> {
     scalars: PatchScalars,
     /// Casts the rays (the methods that cast rays).
     caster: Option<RayCaster<'a, I>>,
+    /// The sky and sun (issue 14) and the sphere they shoot at, until they have shot.
+    sky: Option<(Sky, sky_shots::Bounds)>,
     /// Hemi-cube shots still to come (the hemi-cube methods, or the hybrid before it switches).
     cubes: Option<CubeShooter>,
     cube_hits: Vec<CubeHits>,
@@ -224,7 +231,19 @@ impl<'a, I: Intersector> Driver<'a, I> {
             return Err(SolveError::NoIntersector(method.name()));
         }
         let mut st = State::new(mesh, materials, cfg.stop_fraction);
-        if scalar(&st.energy.emitted) <= 0.0 {
+        let sky = match &cfg.sky {
+            Some(spec) => Some(Sky::new(spec).map_err(|e| SolveError::Sky(e.to_string()))?),
+            None => None,
+        };
+        if sky.is_some() && !method.casts_rays() {
+            return Err(SolveError::SkyNeedsRays(method.name()));
+        }
+        let sky_lit = sky.as_ref().is_some_and(|s| {
+            s.pieces()
+                .iter()
+                .any(|p| scalar(&p.radiance) * p.solid_angle > 0.0)
+        });
+        if scalar(&st.energy.emitted) <= 0.0 && !sky_lit {
             return Err(SolveError::NoEmitter);
         }
         if let Some(g) = &hooks.light_groups {
@@ -252,10 +271,19 @@ impl<'a, I: Intersector> Driver<'a, I> {
                 scalar(&materials[p.material as usize].emission()) * p.area
             })
             .sum();
+        let caster = isect.map(|isect| RayCaster::new(mesh, isect, cfg.seed, cfg.jitter));
+        let bounds = sky_shots::Bounds::of(mesh);
+        // What the sky delivers to the model counts as emitted (sky_shots: "C").
+        let from_sky = match (&sky, &caster) {
+            (Some(sky), Some(caster)) if cfg.energy_per_ray.is_none() => {
+                sky_shots::received_flux(caster, sky, &bounds, cfg.seed)
+            }
+            _ => 0.0,
+        };
         let c = cfg
             .energy_per_ray
             .filter(|c| *c > 0.0)
-            .unwrap_or_else(|| energy_per_ray(mesh, &rho, emitted, cfg.tolerance));
+            .unwrap_or_else(|| energy_per_ray(mesh, &rho, emitted + from_sky, cfg.tolerance));
         let cubes = match method {
             MethodKind::Hemicube | MethodKind::HemicubeJittered => Some(CubeKind::Uniform {
                 n: cfg.hemicube_n,
@@ -272,7 +300,8 @@ impl<'a, I: Intersector> Driver<'a, I> {
             st,
             energy_per_ray: c,
             scalars: PatchScalars::new(mesh, materials),
-            caster: isect.map(|isect| RayCaster::new(mesh, isect, cfg.seed, cfg.jitter)),
+            caster,
+            sky: sky.map(|s| (s, bounds)),
             cubes: cubes.map(|kind| CubeShooter::new(kind, c)),
             cube_hits: Vec::new(),
             switch: SwitchPolicy::new(cfg, model, n),
@@ -288,6 +317,21 @@ impl<'a, I: Intersector> Driver<'a, I> {
             last_sync: None,
             interrupt_now: false,
         })
+    }
+
+    /// The sky's pieces and the sun shoot, before any patch ([`sky_shots`]).
+    fn shoot_sky(&mut self) {
+        if let (Some((sky, bounds)), Some(caster)) = (self.sky.take(), &self.caster) {
+            let done = sky_shots::shoot(
+                &mut self.st,
+                caster,
+                &sky,
+                &bounds,
+                self.energy_per_ray,
+                self.cfg.seed,
+            );
+            self.stats.shots += done.shots;
+        }
     }
 
     /// Carries on from a checkpoint: the books, the counters, the switch policy's state and

@@ -71,6 +71,7 @@ use crate::intersect::{Intersector, Ray};
 use crate::mesh::Mesh;
 use crate::sample::{polar::PolarGrid, Frame};
 use crate::scene::Material;
+use crate::sky::{Sky, Sun};
 use glam::Vec3;
 use rand::seq::SliceRandom;
 use rand::Rng;
@@ -119,6 +120,9 @@ struct Ctx<'a, I> {
     eps_floor: f32,
     seed: u64,
     rays: usize,
+    /// The sky that lights the model from outside (issue 14): rays that leave see it, and its
+    /// sun is sampled like a light.
+    sky: Option<&'a Sky>,
 }
 
 /// A hemisphere ray meeting a side closer than this many times the side's size (√A) takes the
@@ -221,7 +225,13 @@ impl<I: Intersector> Ctx<'_, I> {
         } else {
             (self.rays / 2).max(1)
         };
-        let grid = PolarGrid::for_samples((self.rays - n_direct).max(2) as f64);
+        let sun = self.sky.and_then(Sky::sun);
+        let n_sun = if sun.is_some() {
+            (self.rays / 4).max(1)
+        } else {
+            0
+        };
+        let grid = PolarGrid::for_samples(self.rays.saturating_sub(n_direct + n_sun).max(2) as f64);
         let (nl, nc) = (n_direct as f64, grid.len() as f64);
 
         // Direct: emitters by power, points on them uniform, shadow rays.
@@ -260,6 +270,26 @@ impl<I: Intersector> Ctx<'_, I> {
             }
             for q in 0..3 {
                 h[q] += sum[q] / n_direct as f64;
+            }
+            var += stratified_var(&m);
+        }
+
+        // The sun: directions over its disc, shadow rays to the sky.
+        if let Some(sun) = sun {
+            let (mut m, mut sum) = (Vec::with_capacity(n_sun), [0.0f64; 3]);
+            let here = latin(n_sun, false, &mut rng);
+            let there = latin(n_sun, true, &mut rng);
+            for (&(u, v), &(s, t)) in here.iter().zip(&there) {
+                let x = points.at(u, v) + n * eps;
+                let val = self.sun_sample(i, sun, x, n, eps, f64::from(s), f64::from(t));
+                rays += 1;
+                m.push(scalar(&[0, 1, 2].map(|q| rho[q] * val[q])));
+                for q in 0..3 {
+                    sum[q] += val[q];
+                }
+            }
+            for q in 0..3 {
+                h[q] += sum[q] / n_sun as f64;
             }
             var += stratified_var(&m);
         }
@@ -306,6 +336,9 @@ impl<I: Intersector> Ctx<'_, I> {
                 sub = self.reflected_at(r, org + dir * t, t, 0, &mut rng);
                 rays += sub.rays;
             }
+            if hit.is_none() {
+                sub.v = self.sky_exitance(dir);
+            }
             let val = [0, 1, 2].map(|q| sub.v[q] + emitted[q]);
             m.push(scalar(&[0, 1, 2].map(|q| rho[q] * val[q])));
             for q in 0..3 {
@@ -326,6 +359,46 @@ impl<I: Intersector> Ctx<'_, I> {
         }
         var += stratified_var(&m);
         Gathered { h, ch, var, rays }
+    }
+
+    /// What a ray leaving the model along `dir` returns: the sky's (or the ground glow's)
+    /// radiance as an exitance, π·L (the unit of B that the hemisphere rays average), the sun
+    /// left out (sampled on its own).
+    fn sky_exitance(&self, dir: Vec3) -> [f64; 3] {
+        self.sky.map_or([0.0; 3], |s| {
+            s.radiance(dir).map(|l| l * std::f64::consts::PI)
+        })
+    }
+
+    /// One sample of the sun's irradiance at `x` (normal `n`, on patch `i`): the direction
+    /// (u, v) of its disc, L_sun·Ω_sun·cos θ where a shadow ray leaves the model, else 0.
+    #[allow(clippy::too_many_arguments)]
+    fn sun_sample(
+        &self,
+        i: usize,
+        sun: &Sun,
+        x: Vec3,
+        n: Vec3,
+        eps: f32,
+        u: f64,
+        v: f64,
+    ) -> [f64; 3] {
+        let dir = sun.sample(u, v).normalize();
+        let cos = n.dot(dir);
+        if cos <= 0.0 {
+            return [0.0; 3];
+        }
+        let ray = Ray {
+            org: x,
+            dir,
+            tnear: 0.0,
+            tfar: f32::INFINITY,
+        };
+        if self.cast(i, ray, eps).is_some() {
+            return [0.0; 3];
+        }
+        let w = Sun::solid_angle() * f64::from(cos);
+        sun.radiance().map(|l| l * w)
     }
 
     /// The emitter (index into `emitters`) that `s` ∈ [0, 1) picks along the power CDF, its
@@ -421,6 +494,19 @@ impl<I: Intersector> Ctx<'_, I> {
         };
         rays += 1;
         let hit = self.cast(r, ray, eps);
+        if hit.is_none() {
+            let l = self.sky_exitance(dir);
+            for q in 0..3 {
+                h[q] += l[q];
+            }
+        }
+        if let Some(sun) = self.sky.and_then(Sky::sun) {
+            rays += 1;
+            let l = self.sun_sample(r, sun, x, n, eps, rng.gen(), rng.gen());
+            for q in 0..3 {
+                h[q] += l[q];
+            }
+        }
         if let Some((s, t2)) =
             hit.and_then(|h| Some((mesh.receiver(h.patch, h.back)? as usize, h.t)))
         {
@@ -547,6 +633,7 @@ pub fn apply<I: Intersector>(
     rays: usize,
     group: Option<&[u32]>,
     shooting: &Shooting,
+    sky: Option<&Sky>,
     reference: Option<&[[f64; 3]]>,
     sol: &mut Solution,
     on_trace: &mut impl FnMut(&TracePoint),
@@ -609,6 +696,7 @@ pub fn apply<I: Intersector>(
         eps_floor: reach * 5e-7,
         seed,
         rays: rays.max(4),
+        sky,
     };
     let gathered: Vec<Gathered> = todo.par_iter().map(|&i| ctx.gather(i)).collect();
 

@@ -41,6 +41,7 @@ pub mod lights;
 pub mod passes;
 pub mod ray_shots;
 pub mod settings;
+pub mod sky_shots;
 pub mod stopping;
 pub mod switch;
 
@@ -97,6 +98,15 @@ pub struct EnergyBalance {
     pub escaped: [f64; 3],
     /// Still waiting to be shot.
     pub unshot: [f64; 3],
+    /// Of `emitted`, what distant emitters (sky, ground glow, sun) shot at the model.
+    #[serde(default)]
+    pub distant: [f64; 3],
+    /// Of `absorbed_back`, what came from distant emitters (a one-sided model's outside).
+    #[serde(default)]
+    pub distant_back: [f64; 3],
+    /// Of `escaped`, distant emitters' rays that missed the model.
+    #[serde(default)]
+    pub distant_missed: [f64; 3],
 }
 
 impl EnergyBalance {
@@ -116,8 +126,13 @@ impl EnergyBalance {
     }
 
     /// Fraction of the emitted flux (scalar) that arrived on back faces.
+    /// Distant emitters' rays that met the model's outside (a one-sided model's exterior) or
+    /// missed it are left out: the fraction is of the light that entered the model.
     pub fn back_fraction(&self) -> f64 {
-        scalar(&self.absorbed_back) / scalar(&self.emitted).max(f64::MIN_POSITIVE)
+        let back = scalar(&self.absorbed_back) - scalar(&self.distant_back);
+        let into =
+            scalar(&self.emitted) - scalar(&self.distant_back) - scalar(&self.distant_missed);
+        back.max(0.0) / into.max(f64::MIN_POSITIVE)
     }
 }
 
@@ -230,6 +245,12 @@ pub enum SolveError {
     Checkpoint(String),
     #[error("--method {0} casts rays but no intersector was built")]
     NoIntersector(&'static str),
+    #[error("--sky: {0}")]
+    Sky(String),
+    #[error(
+        "--sky needs a method that casts rays (adaptive-hybrid or adaptive-rays), not --method {0}"
+    )]
+    SkyNeedsRays(&'static str),
 }
 
 /// Solves by the method `cfg.method` names, casting rays through `isect`, with no hooks.

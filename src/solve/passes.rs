@@ -34,6 +34,7 @@ use super::{
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
+use crate::sky::Sky;
 use std::time::Instant;
 
 /// What the error target did (`summary.json`: `error_target`).
@@ -199,6 +200,7 @@ fn gathered<I: Intersector>(
         rays,
         hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
         &shooting,
+        cfg.sky.as_ref().and_then(|s| Sky::new(s).ok()).as_ref(),
         hooks.reference.as_deref().map(Vec::as_slice),
         &mut sol,
         &mut |_| {},

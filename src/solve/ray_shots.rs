@@ -27,7 +27,7 @@ pub const WAVE_RAYS: usize = 32_768;
 pub const CHUNK: usize = 1024;
 /// Hit codes: a patch id, a patch id with this bit for a back-face hit, or [`ESCAPED`].
 pub(super) const BACK: u32 = 1 << 31;
-const ESCAPED: u32 = u32::MAX;
+pub(super) const ESCAPED: u32 = u32::MAX;
 
 /// The energy per ray C (scalar W) for a requested relative error τ of a typical patch: the
 /// paper's "constant of proportionality" between unshot energy and samples (Sec. 2), picked
@@ -177,6 +177,13 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
     }
 
     fn cast_one(&self, shooter: usize, org: Vec3, dir: Vec3, eps: f32) -> u32 {
+        // The shooter's surface: a back twin's rays leave the surface its front patch is.
+        self.cast_from(Some(self.mesh.surface_of(shooter)), org, dir, eps)
+    }
+
+    /// The hit code of a ray from `org` along `dir` that starts on surface `own` (none for a
+    /// distant emitter's ray).
+    pub(super) fn cast_from(&self, own: Option<usize>, org: Vec3, dir: Vec3, eps: f32) -> u32 {
         let mut ray = Ray {
             org,
             dir,
@@ -185,12 +192,10 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         };
         // A ray leaving its own (planar, convex) patch cannot meet it again; if rounding says
         // otherwise, step past it.
-        // The shooter's surface: a back twin's rays leave the surface its front patch is.
-        let own = self.mesh.surface_of(shooter);
         for _ in 0..3 {
             match self.isect.intersect(&ray) {
                 None => return ESCAPED,
-                Some(h) if h.patch as usize == own => ray.tnear = h.t + eps,
+                Some(h) if Some(h.patch as usize) == own => ray.tnear = h.t + eps,
                 // The side met decides the receiver (docs/design.md §7).
                 Some(h) => {
                     return self

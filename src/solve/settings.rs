@@ -167,6 +167,9 @@ pub struct SolveSettings {
     /// After shooting, re-estimate the patches the shooting left noisy by gathering with
     /// rays of their own ([`super::final_gather`]); methods that cast rays only.
     pub final_gather: bool,
+    /// Daylight (issue 14): the sky, ground glow and sun that shoot at the model from outside
+    /// ([`super::sky_shots`]); `None` for none.
+    pub sky: Option<crate::sky::SkySpec>,
     /// Rays per gathered patch at the default tolerance ([`SolveSettings::gather_rays_per_patch`]).
     pub gather_rays: usize,
 }
@@ -190,6 +193,7 @@ impl Default for SolveSettings {
             switch_by: SwitchBy::Counted,
             final_gather: DEFAULT_FINAL_GATHER,
             gather_rays: DEFAULT_GATHER_RAYS,
+            sky: None,
         }
     }
 }

@@ -14,6 +14,7 @@ mod bench;
 mod compare;
 mod saved;
 mod scene;
+mod sky_args;
 mod solve;
 
 use clap::{Parser, Subcommand};

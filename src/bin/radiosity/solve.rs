@@ -1,6 +1,7 @@
 //! `radiosity solve`.
 
 use crate::args::{source, LightGroupsArg, SceneArgs, SolverArgs, ViewArgs};
+use crate::sky_args::SkyArgs;
 use crate::{interrupt_flag, outln};
 use clap::Args;
 use radiosity::pipeline::{self, RunSettings, SolveJob, DEFAULT_CHECKPOINT_EVERY};
@@ -16,6 +17,8 @@ pub struct SolveArgs {
     scene_args: SceneArgs,
     #[command(flatten)]
     solve_args: SolverArgs,
+    #[command(flatten)]
+    sky: SkyArgs,
     /// Output folder.
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -60,12 +63,16 @@ pub struct SolveArgs {
 }
 
 pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
+    let solve = radiosity::solve::SolveSettings {
+        sky: a.sky.spec().map_err(radiosity::Error::Invalid)?,
+        ..a.solve_args.solve_settings()
+    };
     let job = SolveJob {
         source: source(a.scene),
         settings: RunSettings {
             load: a.scene_args.load(),
             mesh: a.scene_args.mesh(),
-            solve: a.solve_args.solve_settings(),
+            solve,
             intersector: a.solve_args.intersector(),
             per_light: a.per_light.then_some(a.light_groups.into()),
         },
