@@ -265,14 +265,15 @@ pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
 /// The material of a polygon's back side, if it has one (docs/design.md §7): its own (a
 /// doubled face merged at load time), else with `--two-sided` its front material — except for
 /// an emitter, whose light leaves its front only (as Radiance's `light`): a lamp stays one-sided.
+/// Glazing (a material that transmits) is always two-sided: a pane is met from both sides.
 pub fn back_material(
     scene: &Scene,
     poly: &crate::scene::Polygon,
     opts: &MeshOptions,
 ) -> Option<u32> {
+    let m = &scene.materials[poly.material as usize];
     poly.back_material.or_else(|| {
-        (opts.two_sided && !scene.materials[poly.material as usize].is_emitter())
-            .then_some(poly.material)
+        ((opts.two_sided && !m.is_emitter()) || m.transmittance > 0.0).then_some(poly.material)
     })
 }
 

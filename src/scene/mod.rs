@@ -59,6 +59,10 @@ pub struct Material {
     pub ke: [f64; 3],
     /// Where [`Material::rho`] came from (shown by `radiosity info`).
     pub rho_source: RhoSource,
+    /// Glazing (issue 14): the share of light that goes straight through, unchanged in
+    /// direction (grey; 0 for opaque). ρ + transmittance ≤ 1; the rest is absorbed. Read from
+    /// the MTL by [`crate::scene::obj`]'s rule (`Tf`, `d`, `Tr`, `illum`).
+    pub transmittance: f64,
 }
 
 /// Where a material's reflectance ρ came from.

@@ -132,10 +132,13 @@ impl State {
             .iter()
             .map(|p| {
                 let m = &materials[p.material as usize];
+                // Glazing: only the 1 − T of rays that do not go through land, and they
+                // carry all its reflection (`RayCaster::with_glazing`).
+                let land = (1.0 - m.transmittance).max(1e-6);
                 PatchState {
                     unshot: m.emission().map(|x| x * p.area),
                     gathered: [0.0; 3],
-                    rho: m.rho.map(|r| r as f32),
+                    rho: m.rho.map(|r| (r / land).min(1.0) as f32),
                     inv_area: (1.0 / p.area) as f32,
                 }
             })

@@ -271,7 +271,13 @@ impl<'a, I: Intersector> Driver<'a, I> {
                 scalar(&materials[p.material as usize].emission()) * p.area
             })
             .sum();
-        let caster = isect.map(|isect| RayCaster::new(mesh, isect, cfg.seed, cfg.jitter));
+        let caster = isect
+            .map(|isect| RayCaster::new(mesh, isect, cfg.seed, cfg.jitter).with_glazing(materials));
+        // Glazing: hemi-cubes cannot see through glass, so rays do all the shooting.
+        let glazed = materials.iter().any(|m| m.transmittance > 0.0);
+        if glazed && !method.casts_rays() {
+            return Err(SolveError::GlazingNeedsRays(method.name()));
+        }
         let bounds = sky_shots::Bounds::of(mesh);
         // What the sky delivers to the model counts as emitted (sky_shots: "C").
         let from_sky = match (&sky, &caster) {
@@ -289,6 +295,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
                 n: cfg.hemicube_n,
                 jitter: method == MethodKind::HemicubeJittered,
             }),
+            MethodKind::AdaptiveHybrid if glazed => None,
             MethodKind::AdaptiveHemicube | MethodKind::AdaptiveHybrid => Some(CubeKind::Adaptive),
             MethodKind::AdaptiveRays | MethodKind::Gathering => None,
         };

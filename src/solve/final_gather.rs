@@ -123,6 +123,8 @@ struct Ctx<'a, I> {
     /// The sky that lights the model from outside (issue 14): rays that leave see it, and its
     /// sun is sampled like a light.
     sky: Option<&'a Sky>,
+    /// Straight-through transmittance per patch (glazing); empty when nothing transmits.
+    trans: Vec<f64>,
 }
 
 /// A hemisphere ray meeting a side closer than this many times the side's size (√A) takes the
@@ -135,6 +137,17 @@ pub const NEAR_DEPTH: u32 = 3;
 
 /// A shooting estimate this many combined σ from the gather's is biased, not noisy: kept out.
 pub const BIAS_Z: f64 = 4.0;
+
+/// What a ray met ([`Ctx::cast`]): the first opaque hit, the transmittance of the glazing
+/// before it, and what the panes' sides it met reflect towards it.
+struct Traced {
+    hit: Option<crate::intersect::Hit>,
+    through: f64,
+    panes: [f64; 3],
+}
+
+/// Surfaces a gather ray may step past (its own, glazing) before it is taken as lost.
+const MAX_STEPS: usize = 16;
 
 /// What a side reflects towards one hemisphere ray (RGB, per channel) and the rays it cost.
 #[derive(Default)]
@@ -193,17 +206,41 @@ fn latin<R: Rng>(n: usize, ordered: bool, rng: &mut R) -> Vec<(f32, f32)> {
 }
 
 impl<I: Intersector> Ctx<'_, I> {
-    /// The closest hit along `ray`, stepping past patch `i`'s own surface (a ray leaving a
-    /// planar patch cannot meet it again; rounding may say otherwise).
-    fn cast(&self, i: usize, mut ray: Ray, eps: f32) -> Option<crate::intersect::Hit> {
+    /// The closest opaque hit along `ray`, stepping past patch `i`'s own surface (a ray leaving
+    /// a planar patch cannot meet it again; rounding may say otherwise).
+    ///
+    /// Glazing (issue 14) is seen and seen through: each pane met adds what its side reflects
+    /// (B − E, times the transmittance of the panes before it) and passes on its transmittance
+    /// T; the ray goes on to the first opaque surface.
+    fn cast(&self, i: usize, mut ray: Ray, eps: f32) -> Traced {
         let own = self.mesh.surface_of(i);
-        for _ in 0..3 {
+        let mut out = Traced {
+            hit: None,
+            through: 1.0,
+            panes: [0.0; 3],
+        };
+        for _ in 0..MAX_STEPS {
             match self.isect.intersect(&ray) {
                 Some(h) if h.patch as usize == own => ray.tnear = h.t + eps,
-                other => return other,
+                Some(h) if self.trans.get(h.patch as usize).is_some_and(|t| *t > 0.0) => {
+                    if let Some(r) = self.mesh.receiver(h.patch, h.back) {
+                        let r = r as usize;
+                        for q in 0..3 {
+                            out.panes[q] += out.through * (self.b[r][q] - self.e[r][q]).max(0.0);
+                        }
+                    }
+                    out.through *= self.trans[h.patch as usize];
+                    ray.tnear = h.t + (h.t * 1e-5).max(self.eps_floor);
+                }
+                other => {
+                    out.hit = other;
+                    return out;
+                }
             }
         }
-        None
+        // Lost among surfaces: nothing seen beyond.
+        out.through = 0.0;
+        out
     }
 
     fn gather(&self, i: usize) -> Gathered {
@@ -311,7 +348,8 @@ impl<I: Intersector> Ctx<'_, I> {
                 tfar: f32::INFINITY,
             };
             rays += 1;
-            let hit = self.cast(i, ray, eps);
+            let seen = self.cast(i, ray, eps);
+            let hit = seen.hit;
             let recv = hit.and_then(|h| Some((mesh.receiver(h.patch, h.back)? as usize, h.t)));
             // What it reflects (the solution's, or followed on when near: `reflected_at`), plus
             // (when there are light samples too) its emission at the hemisphere ray's MIS
@@ -339,7 +377,7 @@ impl<I: Intersector> Ctx<'_, I> {
             if hit.is_none() {
                 sub.v = self.sky_exitance(dir);
             }
-            let val = [0, 1, 2].map(|q| sub.v[q] + emitted[q]);
+            let val = [0, 1, 2].map(|q| seen.panes[q] + seen.through * (sub.v[q] + emitted[q]));
             m.push(scalar(&[0, 1, 2].map(|q| rho[q] * val[q])));
             for q in 0..3 {
                 sum[q] += val[q];
@@ -349,7 +387,7 @@ impl<I: Intersector> Ctx<'_, I> {
                     let own = self.group.is_some_and(|g| g[r] as usize == c);
                     for q in 0..3 {
                         let lit = if own { emitted[q] } else { 0.0 };
-                        chc[q] += (sub.ch[c][q] + lit) / x_count as f64;
+                        chc[q] += seen.through * (sub.ch[c][q] + lit) / x_count as f64;
                     }
                 }
             }
@@ -394,10 +432,11 @@ impl<I: Intersector> Ctx<'_, I> {
             tnear: 0.0,
             tfar: f32::INFINITY,
         };
-        if self.cast(i, ray, eps).is_some() {
+        let seen = self.cast(i, ray, eps);
+        if seen.hit.is_some() {
             return [0.0; 3];
         }
-        let w = Sun::solid_angle() * f64::from(cos);
+        let w = seen.through * Sun::solid_angle() * f64::from(cos);
         sun.radiance().map(|l| l * w)
     }
 
@@ -493,12 +532,15 @@ impl<I: Intersector> Ctx<'_, I> {
             tfar: f32::INFINITY,
         };
         rays += 1;
-        let hit = self.cast(r, ray, eps);
-        if hit.is_none() {
-            let l = self.sky_exitance(dir);
-            for q in 0..3 {
-                h[q] += l[q];
-            }
+        let seen = self.cast(r, ray, eps);
+        let (hit, w) = (seen.hit, seen.through);
+        let l = if hit.is_none() {
+            self.sky_exitance(dir)
+        } else {
+            [0.0; 3]
+        };
+        for q in 0..3 {
+            h[q] += seen.panes[q] + w * l[q];
         }
         if let Some(sun) = self.sky.and_then(Sky::sun) {
             rays += 1;
@@ -525,12 +567,12 @@ impl<I: Intersector> Ctx<'_, I> {
             let sub = self.reflected_at(s, x + dir * t2, t2, depth + 1, rng);
             rays += sub.rays;
             for q in 0..3 {
-                h[q] += sub.v[q] + emitted[q];
+                h[q] += w * (sub.v[q] + emitted[q]);
             }
             for (c, chc) in ch.iter_mut().enumerate() {
                 let own = self.group.is_some_and(|g| g[s] as usize == c);
                 for q in 0..3 {
-                    chc[q] += sub.ch[c][q] + if own { emitted[q] } else { 0.0 };
+                    chc[q] += w * (sub.ch[c][q] + if own { emitted[q] } else { 0.0 });
                 }
             }
         }
@@ -567,14 +609,16 @@ impl<I: Intersector> Ctx<'_, I> {
         };
         // Seen: the ray meets j's emitting side first, or nothing before j's plane (a ray
         // aimed at j may be given to a neighbouring patch of the same plane at an edge).
-        let seen = match self.cast(i, ray, eps) {
+        let traced = self.cast(i, ray, eps);
+        let seen = match traced.hit {
             None => true,
             Some(h) => {
                 self.mesh.receiver(h.patch, h.back) == Some(j as u32) || h.t >= dist * (1.0 - 1e-4)
             }
         };
         let g = if seen {
-            f64::from(cos_i) * f64::from(cos_j) / (std::f64::consts::PI * f64::from(dist).powi(2))
+            traced.through * f64::from(cos_i) * f64::from(cos_j)
+                / (std::f64::consts::PI * f64::from(dist).powi(2))
         } else {
             0.0
         };
@@ -697,6 +741,11 @@ pub fn apply<I: Intersector>(
         seed,
         rays: rays.max(4),
         sky,
+        trans: if materials.iter().any(|m| m.transmittance > 0.0) {
+            (0..np).map(|i| mat(i).transmittance).collect()
+        } else {
+            Vec::new()
+        },
     };
     let gathered: Vec<Gathered> = todo.par_iter().map(|&i| ctx.gather(i)).collect();
 

@@ -245,6 +245,8 @@ pub enum SolveError {
     Checkpoint(String),
     #[error("--method {0} casts rays but no intersector was built")]
     NoIntersector(&'static str),
+    #[error("the scene has glazing (a material that transmits light), which hemi-cubes cannot see through: use a method that casts rays (adaptive-hybrid or adaptive-rays), not --method {0}")]
+    GlazingNeedsRays(&'static str),
     #[error("--sky: {0}")]
     Sky(String),
     #[error(

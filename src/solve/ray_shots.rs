@@ -28,6 +28,8 @@ pub const CHUNK: usize = 1024;
 /// Hit codes: a patch id, a patch id with this bit for a back-face hit, or [`ESCAPED`].
 pub(super) const BACK: u32 = 1 << 31;
 pub(super) const ESCAPED: u32 = u32::MAX;
+/// Surfaces a ray may step past (its own, glazing) before it is taken as lost.
+const MAX_STEPS: usize = 16;
 
 /// The energy per ray C (scalar W) for a requested relative error τ of a typical patch: the
 /// paper's "constant of proportionality" between unshot energy and samples (Sec. 2), picked
@@ -140,6 +142,9 @@ pub(super) struct RayCaster<'a, I> {
     jitter: bool,
     /// Smallest offset of ray origins off their patch: a few ulps of the largest coordinate.
     eps_floor: f32,
+    /// Straight-through transmittance per patch (glazing, issue 14); empty when nothing
+    /// transmits.
+    trans: Vec<f32>,
 }
 
 impl<'a, I: Intersector> RayCaster<'a, I> {
@@ -154,7 +159,20 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
             seed,
             jitter,
             eps_floor: reach * 5e-7,
+            trans: Vec::new(),
         }
+    }
+
+    /// Lets rays through glazing: a ray that meets a patch of transmittance T goes on
+    /// unchanged with probability T (every ray keeps its energy C); the rest land on it, which
+    /// keeps ρ/(1 − T) of them ([`super::books::State::new`]), so it reflects ρ of all the
+    /// light it receives.
+    pub fn with_glazing(mut self, materials: &[crate::scene::Material]) -> Self {
+        let t = |p: &crate::mesh::Patch| materials[p.material as usize].transmittance as f32;
+        if self.mesh.patches.iter().any(|p| t(p) > 0.0) {
+            self.trans = self.mesh.patches.iter().map(t).collect();
+        }
+        self
     }
 
     /// Casts rays `first..first + count` of `shot` (its chunk `chunk`); a hit code per ray.
@@ -171,19 +189,26 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         for k in first..first + count {
             let dir = frame.to_world(shot.grid.direction(k, 0.0, self.jitter, &mut rng));
             let org = points.sample(&mut rng) + patch.normal * eps;
-            out.push(self.cast_one(i, org, dir, eps));
+            out.push(self.cast_one(i, org, dir, eps, &mut rng));
         }
         out
     }
 
-    fn cast_one(&self, shooter: usize, org: Vec3, dir: Vec3, eps: f32) -> u32 {
+    fn cast_one<R: Rng>(&self, shooter: usize, org: Vec3, dir: Vec3, eps: f32, rng: &mut R) -> u32 {
         // The shooter's surface: a back twin's rays leave the surface its front patch is.
-        self.cast_from(Some(self.mesh.surface_of(shooter)), org, dir, eps)
+        self.cast_from(Some(self.mesh.surface_of(shooter)), org, dir, eps, rng)
     }
 
     /// The hit code of a ray from `org` along `dir` that starts on surface `own` (none for a
     /// distant emitter's ray).
-    pub(super) fn cast_from(&self, own: Option<usize>, org: Vec3, dir: Vec3, eps: f32) -> u32 {
+    pub(super) fn cast_from<R: Rng>(
+        &self,
+        own: Option<usize>,
+        org: Vec3,
+        dir: Vec3,
+        eps: f32,
+        rng: &mut R,
+    ) -> u32 {
         let mut ray = Ray {
             org,
             dir,
@@ -192,10 +217,13 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         };
         // A ray leaving its own (planar, convex) patch cannot meet it again; if rounding says
         // otherwise, step past it.
-        for _ in 0..3 {
+        for _ in 0..MAX_STEPS {
             match self.isect.intersect(&ray) {
                 None => return ESCAPED,
                 Some(h) if Some(h.patch as usize) == own => ray.tnear = h.t + eps,
+                Some(h) if self.passes(h.patch as usize, rng) => {
+                    ray.tnear = h.t + (h.t * 1e-5).max(self.eps_floor);
+                }
                 // The side met decides the receiver (docs/design.md §7).
                 Some(h) => {
                     return self
@@ -206,6 +234,12 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
             }
         }
         ESCAPED
+    }
+
+    /// Whether a ray that met `patch` goes through it (glazing).
+    #[inline]
+    fn passes<R: Rng>(&self, patch: usize, rng: &mut R) -> bool {
+        !self.trans.is_empty() && self.trans[patch] > 0.0 && rng.gen::<f32>() < self.trans[patch]
     }
 
     /// Casts every ray of `shot` on the calling thread, not applied; returns how many.

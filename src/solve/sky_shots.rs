@@ -100,7 +100,8 @@ fn piece_ray<R: Rng>(
 }
 
 /// The scalar flux the model receives from the sky (for C): each piece's flux times the
-/// share of its pilot rays that meet a surface.
+/// share of its pilot rays that meet a surface (front or back). When no pilot ray meets the
+/// model, the whole flux shot at it (so C stays finite: the sky's rays then mostly leave).
 pub(super) fn received_flux<I: Intersector>(
     caster: &RayCaster<'_, I>,
     sky: &Sky,
@@ -108,7 +109,8 @@ pub(super) fn received_flux<I: Intersector>(
     seed: u64,
 ) -> f64 {
     let grid = PolarGrid::for_samples(PILOT_RAYS as f64);
-    sky.pieces()
+    let received: f64 = sky
+        .pieces()
         .par_iter()
         .enumerate()
         .map(|(k, piece)| {
@@ -116,12 +118,20 @@ pub(super) fn received_flux<I: Intersector>(
             let hits = (0..grid.len())
                 .filter(|&r| {
                     let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);
-                    caster.cast_from(None, org, dir, 0.0) != ESCAPED
+                    caster.cast_from(None, org, dir, 0.0, &mut rng) != ESCAPED
                 })
                 .count();
             super::scalar(&piece_flux(piece, bounds)) * hits as f64 / grid.len() as f64
         })
-        .sum()
+        .sum();
+    if received > 0.0 {
+        received
+    } else {
+        sky.pieces()
+            .iter()
+            .map(|p| super::scalar(&piece_flux(p, bounds)))
+            .sum()
+    }
 }
 
 /// What the sky's shots did.
@@ -159,7 +169,7 @@ pub(super) fn shoot<I: Intersector>(
                     (ch * CHUNK..(ch * CHUNK + CHUNK).min(x))
                         .map(|r| {
                             let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);
-                            caster.cast_from(None, org, dir, 0.0)
+                            caster.cast_from(None, org, dir, 0.0, &mut rng)
                         })
                         .collect()
                 })

@@ -36,7 +36,11 @@ pub(super) fn verdict(
 ) -> Option<StopReason> {
     if p.interrupted {
         Some(StopReason::Interrupted)
-    } else if p.max_unshot_b * p.amplification < cfg.stop_fraction * p.mean_b {
+    } else if p.max_unshot_b * p.amplification < cfg.stop_fraction * p.mean_b
+        || p.max_unshot_b <= 0.0
+    {
+        // (Nothing unshot above the threshold: also when nothing is lit at all, as inside a
+        // closed box under a sky.)
         // The max-ΔB heap holds only patches above the threshold; whether any energy at all is
         // left, the flux heap says.
         if has_unshot() {

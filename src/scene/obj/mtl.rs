@@ -68,7 +68,55 @@ pub(super) fn convert_material(m: &tobj::Material) -> Result<Material, String> {
         rho,
         ke,
         rho_source,
+        transmittance: transmittance(m)?,
     })
+}
+
+/// The straight-through transmittance of a glazing material, from what exporters write:
+///
+/// - dissolve below opaque (`d` < 1, or `Tr` > 0 where there is no `d`): T = (1 − d) × the
+///   mean of `Tf` (1 where there is none);
+/// - a transparency illumination model (`illum` 4, 6, 7 or 9) with `Tf`: T = mean `Tf`;
+/// - a `Tf` strictly between 0 and 1 in some channel: T = mean `Tf`;
+/// - otherwise opaque: exporters write `Tf 1 1 1` (and some `Tf 0 0 0`) on every material.
+///
+/// The colour of `Tf` is not kept: glazing is grey (every ray carries the same energy).
+fn transmittance(m: &tobj::Material) -> Result<f64, String> {
+    let number = |key: &str| -> Result<Option<f64>, String> {
+        m.unknown_param
+            .get(key)
+            .map(|t| {
+                t.trim()
+                    .parse::<f64>()
+                    .map_err(|_| format!("material '{}': cannot read {key} '{t}'", m.name))
+            })
+            .transpose()
+    };
+    let tf = match m.unknown_param.get("Tf") {
+        Some(t) => Some(
+            parse_colour(t)
+                .ok_or_else(|| format!("material '{}': cannot read Tf '{t}'", m.name))?,
+        ),
+        None => None,
+    };
+    let opacity = match m.dissolve {
+        Some(d) => Some(to_f64(d)),
+        None => number("Tr")?.map(|tr| 1.0 - tr),
+    };
+    let mean = |c: [f64; 3]| (c[0] + c[1] + c[2]) / 3.0;
+    let t = match (opacity, tf) {
+        (Some(d), _) if d < 1.0 => (1.0 - d) * tf.map_or(1.0, mean),
+        (_, Some(c)) if matches!(m.illumination_model, Some(4 | 6 | 7 | 9)) => mean(c),
+        (_, Some(c)) if c.iter().any(|x| *x > 0.0 && *x < 1.0) => mean(c),
+        _ => 0.0,
+    };
+    if !(0.0..=1.0).contains(&t) {
+        return Err(format!(
+            "material '{}': its transmittance {t} (from Tf, d, Tr) is not within [0, 1]",
+            m.name
+        ));
+    }
+    Ok(t)
 }
 
 /// ρ = `Kd` × the mean colour of `map_Kd` where the texture loads (one warning, naming each
@@ -149,6 +197,32 @@ pub(super) fn textures_and_clamp(
             list(&clamped)
         ));
     }
+    glazing(name, materials, warnings);
+}
+
+/// Glazing that would reflect and transmit more than it receives (ρ + T > 1 in a channel) is
+/// given T = 1 − max ρ, with one warning naming the materials.
+fn glazing(name: &str, materials: &mut [Material], warnings: &mut Vec<String>) {
+    let mut cut = Vec::new();
+    for m in materials.iter_mut().filter(|m| m.transmittance > 0.0) {
+        let room = 1.0 - m.rho.iter().copied().fold(0.0, f64::max);
+        if m.transmittance > room {
+            cut.push(format!(
+                "'{}' ({:.3} → {:.3})",
+                m.name,
+                m.transmittance,
+                room.max(0.0)
+            ));
+            m.transmittance = room.max(0.0);
+        }
+    }
+    if !cut.is_empty() {
+        warnings.push(format!(
+            "{name}: glazing that would reflect and transmit more light than it receives (Kd + \
+             transmittance above 1) transmits less: {}",
+            list(&cut)
+        ));
+    }
 }
 
 /// `a, b, c`, shortened after 20 items.
@@ -174,6 +248,7 @@ pub(super) fn default_grey(materials: &[Material]) -> Material {
         rho: [DEFAULT_GREY; 3],
         ke: [0.0; 3],
         rho_source: RhoSource::Default,
+        transmittance: 0.0,
     }
 }
 

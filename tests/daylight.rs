@@ -1,0 +1,122 @@
+//! Issue 14, daylight: the sky, ground glow and sun as distant emitters that shoot first, and
+//! glazing. Furnaces: an unobstructed horizontal plane under a sky receives exactly the sky's
+//! horizontal illuminance; a closed box receives nothing; a pane of transmittance T passes T.
+
+use glam::{vec3, Vec3};
+use radiosity::scene::{Material, Scene};
+use radiosity::sky::{SkyKind, SkyLevel, SkySpec, SunLevel, EFFICACY};
+use radiosity::solve::{Solution, SolveSettings};
+
+mod common;
+use common::{closed_box, material, mesh_at, quad, solve_mesh};
+
+fn sky(kind: SkyKind, sun: Option<(f64, f64)>) -> SkySpec {
+    SkySpec {
+        kind,
+        level: SkyLevel::HorizontalIlluminance(10_000.0),
+        sun_position: sun.map(|(alt, azi)| radiosity::sky::SolarAngles::new(alt, azi).unwrap()),
+        sun: sun.map(|_| SunLevel::NormalIlluminance(60_000.0)),
+        ..SkySpec::default()
+    }
+}
+
+fn solve(scene: &Scene, spec: SkySpec) -> (radiosity::mesh::Mesh, Solution) {
+    let m = mesh_at(scene, Some(0.5));
+    let cfg = SolveSettings {
+        sky: Some(spec),
+        ..SolveSettings::default()
+    };
+    let sol = solve_mesh(scene, &m, &cfg);
+    let e = &sol.stats.energy;
+    assert!(e.relative_residual() < 1e-9, "{e:?}");
+    (m, sol)
+}
+
+/// Area-weighted mean illuminance (lux, green channel) over the patches `keep` picks.
+fn lux(
+    m: &radiosity::mesh::Mesh,
+    sol: &Solution,
+    rho: f64,
+    keep: impl Fn(Vec3, Vec3) -> bool,
+) -> f64 {
+    let (mut sum, mut area) = (0.0, 0.0);
+    for (p, b) in m.patches.iter().zip(&sol.b) {
+        if keep(p.centre, p.normal) {
+            sum += b[1] / rho * p.area;
+            area += p.area;
+        }
+    }
+    assert!(area > 0.0);
+    EFFICACY * sum / area
+}
+
+/// A 10 m × 10 m horizontal plane facing up (Y), ρ = 0.5.
+fn plane() -> Scene {
+    let mut s = Scene {
+        materials: vec![material("grey", 0.5, 0.0)],
+        ..Scene::default()
+    };
+    let p = |x, z| vec3(x, 0.0, z);
+    quad(&mut s, [p(-5., 5.), p(5., 5.), p(5., -5.), p(-5., -5.)], 0);
+    s
+}
+
+#[test]
+fn an_unobstructed_plane_receives_the_skys_horizontal_illuminance() {
+    let s = plane();
+    for kind in [SkyKind::Uniform, SkyKind::Overcast] {
+        let (m, sol) = solve(&s, sky(kind, None));
+        let e = lux(&m, &sol, 0.5, |_, _| true);
+        assert!((e - 10_000.0).abs() < 50.0, "{kind:?}: {e} lux");
+    }
+    // With a sun 40° up: the sky plus 60,000·sin 40° lux.
+    let (m, sol) = solve(&s, sky(SkyKind::Overcast, Some((40.0, 10.0))));
+    let e = lux(&m, &sol, 0.5, |_, _| true);
+    let want = 10_000.0 + 60_000.0 * 40f64.to_radians().sin();
+    assert!((e - want).abs() < 0.01 * want, "{e} lux, want {want}");
+}
+
+#[test]
+fn a_closed_box_under_a_sky_and_sun_receives_nothing() {
+    let s = closed_box(4.0, 3.0, 4.0, material("wall", 0.6, 0.0));
+    let (_, sol) = solve(&s, sky(SkyKind::Clear, Some((30.0, 20.0))));
+    assert!(sol.b.iter().all(|b| *b == [0.0; 3]));
+    let e = &sol.stats.energy;
+    assert!(e.back_fraction() == 0.0, "{e:?}");
+}
+
+/// The closed box with its roof (y = 3) replaced: open, or a pane of transmittance 0.7.
+fn roofed(glass: bool) -> Scene {
+    let mut s = closed_box(4.0, 3.0, 4.0, material("wall", 0.6, 0.0));
+    let roof = s
+        .polygons
+        .iter()
+        .position(|p| {
+            let idx = &s.indices[p.first as usize..(p.first + p.len) as usize];
+            idx.iter().all(|&i| s.positions[i as usize].y == 3.0)
+        })
+        .unwrap();
+    if glass {
+        s.materials.push(Material {
+            name: "glass".into(),
+            transmittance: 0.7,
+            ..Material::default()
+        });
+        s.polygons[roof].material = 1;
+    } else {
+        s.polygons.remove(roof);
+    }
+    s
+}
+
+#[test]
+fn glazing_passes_its_transmittance_and_the_books_close() {
+    let floor = |c: Vec3, n: Vec3| c.y < 1e-3 && n.y > 0.9;
+    let (mo, open) = solve(&roofed(false), sky(SkyKind::Uniform, None));
+    let (mg, glazed) = solve(&roofed(true), sky(SkyKind::Uniform, None));
+    let (eo, eg) = (lux(&mo, &open, 0.6, floor), lux(&mg, &glazed, 0.6, floor));
+    // A black pane (ρ = 0) of T = 0.7: every path into the box crosses it once.
+    assert!((eg / eo - 0.7).abs() < 0.02, "glazed {eg} / open {eo}");
+    // The pane is two-sided: light from outside is not lost on its back.
+    assert!(glazed.stats.energy.back_fraction() < 1e-9);
+}
