@@ -34,7 +34,9 @@ hole) is split at its pane's plane, so its patches are either outside or inside 
 
 A face's material follows from what it faces: an empty cell inside the building (a room box)
 makes floor (facing up), ceiling (facing down) or wall; a cell in a hole makes reveal; a cell
-outside makes roof, facade or soffit (the underside of the ground slab). Furniture has its own.
+outside makes roof, facade or soffit (the underside of the ground slab). Furniture has its own,
+and the atrium's parapets are wall all round (so only floors are ``floor``: the grid's rule in
+``daylight.py --points-only`` puts its work plane over faces of that name).
 
 Materials (``daylit.mtl``, grey, diffuse reflectance Kd): ceiling 0.8, wall 0.6, floor 0.3,
 reveal 0.6, facade 0.4, roof 0.2, soffit 0.2, desk 0.5, partition 0.5, and ``glass``: Kd 0.08
@@ -71,8 +73,8 @@ MATERIALS = {
 }
 
 SHELL = 1  # solid kinds: the building's fabric, then furniture
-KIND_MATERIAL = {2: "desk", 3: "partition"}
-DESK, PARTITION = 2, 3
+KIND_MATERIAL = {2: "desk", 3: "partition", 4: "wall"}
+DESK, PARTITION, PARAPET = 2, 3, 4
 
 
 def r6(x: float) -> float:
@@ -317,10 +319,10 @@ def atrium() -> Building:
         b.cut((void[0], void[1], level - 0.3, level, void[2], void[3]))  # ... open over the atrium
         t, h = 0.15, 1.0  # parapets on the slab's edge, around the void
         x0, x1, z0, z1 = void
-        b.add((x0 - t, x0, level, level + h, z0 - t, z1 + t))
-        b.add((x1, x1 + t, level, level + h, z0 - t, z1 + t))
-        b.add((x0, x1, level, level + h, z0 - t, z0))
-        b.add((x0, x1, level, level + h, z1, z1 + t))
+        b.add((x0 - t, x0, level, level + h, z0 - t, z1 + t), PARAPET)
+        b.add((x1, x1 + t, level, level + h, z0 - t, z1 + t), PARAPET)
+        b.add((x0, x1, level, level + h, z0 - t, z0), PARAPET)
+        b.add((x0, x1, level, level + h, z1, z1 + t), PARAPET)
     b.window((void[0], void[1], 12.0, 12.3, void[2], void[3]), axis=1, sign=-1)
     return b
 
