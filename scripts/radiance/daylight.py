@@ -381,6 +381,8 @@ class Radiance:
                      "-as", str(args.as_), "-aa", str(args.aa), "-lr", str(args.lr), "-lw",
                      f"{lw:.3g}", "-dt", "0", "-dc", "1", "-ds", "0.02", "-dj", "0", "-dr", "0",
                      "-u+"]
+        if args.ar is not None:
+            self.opts[-1:-1] = ["-ar", str(args.ar)]
         self.run_seconds = []
 
     def octree(self, model, sky: SkySettings, name="scene") -> Path:
@@ -465,20 +467,64 @@ def comparison(tool_lux, ref_lux):
 
 
 def noise(runs):
-    """Radiance's own noise: per point, the standard error of the mean of the runs; as an
-    area-averaged figure (sum se / sum mean) and at the median point; and the same for one run
-    (what a single run at these settings would carry)."""
-    if len(runs) < 2:
+    """Radiance's own noise, from its ``k`` independent runs, as the errors it puts into the
+    comparison's figures. Each run's error at a point is estimated by leave-one-out:
+    e_j = (x_j - mean of the other runs) sqrt((k - 1) / k) (for k = 2: (x_1 - x_2) / sqrt 2),
+    which has the variance of one run's error; then, for one run,
+
+    - ``one_run_area_averaged``: sum |e_j| / sum lux, averaged over j;
+    - ``one_run_median_point``: the median over the points of |e_j| / lux, averaged over j;
+    - ``one_run_point_rms``: the root mean square over the points of s / lux (s the sample
+      standard deviation of the runs: unbiased in its square);
+
+    and for the reference (the mean of the k runs) the same divided by sqrt(k): ``area_averaged``,
+    ``median_point``, ``point_rms``. No normal distribution is assumed (the error at a point
+    is skewed where a few ambient rays find a small bright opening)."""
+    k = len(runs)
+    if k < 2:
         return {}
     mean = runs.mean(axis=0)
-    se = runs.std(axis=0, ddof=1) / math.sqrt(len(runs))
     lit = mean > 0
-    one = se * math.sqrt(len(runs))
-    return {"area_averaged": float(se.sum() / mean.sum()),
-            "median_point": float(np.median(se[lit] / mean[lit])),
-            "one_run_area_averaged": float(one.sum() / mean.sum()),
-            "one_run_median_point": float(np.median(one[lit] / mean[lit])),
-            "run_to_run_area_averaged": float(np.abs(runs[0] - runs[1]).sum() / mean.sum())}
+    area, med = [], []
+    for j in range(k):
+        others = np.delete(runs, j, axis=0).mean(axis=0)
+        e = np.abs(runs[j] - others) * math.sqrt((k - 1) / k)
+        area.append(e.sum() / mean.sum())
+        med.append(float(np.median(e[lit] / mean[lit])))
+    s = runs.std(axis=0, ddof=1)
+    one = {"one_run_area_averaged": float(np.mean(area)),
+           "one_run_median_point": float(np.mean(med)),
+           "one_run_point_rms": float(np.sqrt(np.mean((s[lit] / mean[lit]) ** 2)))}
+    out = {"runs": k}
+    for key, v in one.items():
+        out[key.replace("one_run_", "")] = v / math.sqrt(k)
+    out.update(one)
+    return out
+
+
+def speed(tool_seconds: dict, rad: dict, fig: dict) -> dict:
+    """Times side by side. The tool's time is its solve (plus the grid's gather when the
+    summary gives it apart). ``speed_ratio`` = Radiance's time for one run at the settings used
+    / the tool's. It counts for the bar only where one Radiance run is at least as accurate as
+    the tool (its one-run area-averaged noise at most the tool's area-averaged error): else
+    ``speed_meets`` is None. ``radiance_seconds_at_tool_accuracy`` extrapolates one run's time
+    to the settings whose noise would equal the tool's error (noise ~ 1 / sqrt(time): an
+    estimate to choose ``--ad`` by, not a measurement)."""
+    t_tool = (tool_seconds.get("solve") or 0.0) + (tool_seconds.get("grid") or 0.0)
+    t_rad = rad["seconds_one_run"]
+    out = {"tool_seconds": t_tool, "radiance_seconds_one_run": t_rad,
+           "speed_ratio": t_rad / t_tool if t_tool > 0 else None,
+           "speed_meets": None, "radiance_seconds_at_tool_accuracy": None,
+           "speed_ratio_at_tool_accuracy": None}
+    nz = rad["noise"].get("one_run_area_averaged")
+    err = fig["area_averaged_relative_error"]
+    if nz is not None and err > 0:
+        if nz <= err and out["speed_ratio"] is not None:
+            out["speed_meets"] = out["speed_ratio"] >= BARS["speed"]
+        t_eq = t_rad * (nz / err) ** 2
+        out["radiance_seconds_at_tool_accuracy"] = t_eq
+        out["speed_ratio_at_tool_accuracy"] = t_eq / t_tool if t_tool > 0 else None
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -587,10 +633,14 @@ def parse_args(argv=None):
     r.add_argument("--ad", type=int, default=4096, help="-ad (default 4096)")
     r.add_argument("--as", dest="as_", type=int, default=0, help="-as (default 0)")
     r.add_argument("--aa", type=float, default=0.0, help="-aa (default 0: no cache)")
+    r.add_argument("--ar", type=int, help="-ar (only with --aa above 0; Radiance's default)")
     r.add_argument("--lr", type=int, default=-12, help="-lr (default -12)")
     r.add_argument("--lw", type=float, help="-lw (default 0.5 / ad, so first-bounce rays are "
                    "not cut short)")
     r.add_argument("--procs", type=int, default=os.cpu_count() or 1, help="rtrace -n")
+    ap.add_argument("--reference", type=Path, metavar="CSV",
+                    help="also compare this Radiance run (e.g. cheaper settings) with another's "
+                    "radiance-grid.csv on the same points: Radiance's own accuracy for its time")
     ap.add_argument("--reuse", action="store_true",
                     help="reuse Radiance's result saved in --out when made for the same model, "
                     "points, sky and settings")
@@ -710,18 +760,23 @@ def main(argv=None):
                      "grid": stats(ref, 100 * ref / sky.sky_illuminance)},
         "bars": BARS,
     }
+    if args.reference:
+        rp, _, rx = read_points_csv(args.reference)
+        if rp.shape != pts.shape or not np.allclose(rp, pts, atol=1e-5):
+            sys.exit(f"--reference {args.reference}: not the same points")
+        fig_r = comparison(ref, rx["lux"])
+        fig_r["reference"] = str(args.reference)
+        report["radiance_vs_reference"] = fig_r
     if tool is not None:
         lux_t, df_t = tool["lux"], tool["df"]
         if len(lux_t) != len(ref):
             sys.exit("the tool's grid and Radiance's differ in length")
         fig = comparison(lux_t, ref)
-        t_tool = (tool["seconds"]["solve"] or 0.0) + (tool["seconds"].get("grid") or 0.0)
-        fig["speed_ratio"] = (report["radiance"]["seconds_one_run"] / t_tool
-                              if t_tool > 0 else None)
+        fig.update(speed(tool["seconds"], report["radiance"], fig))
         fig["meets"] = {
             "area_averaged": fig["area_averaged_relative_error"] <= BARS["area_averaged"],
             "median_point": (fig["median_point_relative_error"] or 0) <= BARS["median_point"],
-            "speed": (fig["speed_ratio"] or 0) >= BARS["speed"]}
+            "speed": fig["speed_meets"]}
         report["tool"] = {k: v for k, v in tool.items() if k not in ("lux", "df")}
         report["tool"]["grid"] = stats(lux_t, df_t if df_t is not None
                                        else 100 * lux_t / sky.sky_illuminance)
@@ -758,9 +813,16 @@ def print_table(r, out):
         nz = rad["noise"]
         print(f"  Radiance noise (its mean of {rad['repeat']}): "
               f"{100 * nz['area_averaged']:.2f} % area-averaged, {100 * nz['median_point']:.2f} % "
-              f"median point; one run: {100 * nz['one_run_area_averaged']:.2f} % / "
-              f"{100 * nz['one_run_median_point']:.2f} %")
+              f"median point, {100 * nz['point_rms']:.2f} % rms point; one run: "
+              f"{100 * nz['one_run_area_averaged']:.2f} % / "
+              f"{100 * nz['one_run_median_point']:.2f} % / {100 * nz['one_run_point_rms']:.2f} %")
     print(f"  Radiance time: {rad['seconds_one_run']:.1f} s per run ({rad['rtrace']})")
+    if "radiance_vs_reference" in r:
+        f = r["radiance_vs_reference"]
+        print(f"  this Radiance (mean of {rad['repeat']}) against {f['reference']}: "
+              f"area-averaged {100 * f['area_averaged_relative_error']:.2f} % (signed "
+              f"{100 * f['area_averaged_signed_error']:+.2f} %), median point "
+              f"{100 * f['median_point_relative_error']:.2f} %")
     if "figures" in r:
         f = r["figures"]
         t = r["tool"]["seconds"]
@@ -768,36 +830,64 @@ def print_table(r, out):
               f"(signed {100 * f['area_averaged_signed_error']:+.2f} %), median point "
               f"{100 * f['median_point_relative_error']:.2f} %, 90th percentile "
               f"{100 * f['p90_point_relative_error']:.2f} %")
-        speed = f"{f['speed_ratio']:.1f}x" if f["speed_ratio"] else "-"
+        ratio = f"{f['speed_ratio']:.1f}x" if f["speed_ratio"] else "-"
+        eq = (f"{f['radiance_seconds_at_tool_accuracy']:.2f} s, "
+              f"{f['speed_ratio_at_tool_accuracy']:.1f}x" if f["speed_ratio_at_tool_accuracy"]
+              else "-")
         print(f"  tool solve {t['solve']} s (grid {t.get('grid', '-')} s); Radiance one run / "
-              f"tool = {speed}; bars met: {f['meets']}")
+              f"tool = {ratio}; Radiance at the tool's accuracy (extrapolated): {eq}")
+        print(f"  bars met (area-averaged <= 5 %, median point <= 10 %, >= 10x faster): "
+              f"{f['meets']}")
     print(f"  report: {out / 'report.json'}; Radiance's grid: {out / 'radiance-grid.csv'}")
 
 
 def print_markdown(paths):
-    """One Markdown row per report (scene and sky)."""
-    print("| scene, sky | points | Radiance mean / min lux, U | tool mean / min lux, U | "
-          "area-averaged | median point | Radiance noise (area / median) | tool solve | "
-          "Radiance one run | ratio |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
-    for p in paths:
-        r = json.loads(Path(p).read_text())
+    """Markdown tables of report.json files: one row per scene and sky (Radiance's reference,
+    and the tool against it when there is one); then, for reports made with --reference, a
+    row per Radiance setting with its accuracy against the reference and its time."""
+    reports = [(p, json.loads(Path(p).read_text())) for p in paths]
+    main_rows = [r for _, r in reports if "radiance_vs_reference" not in r]
+    ref_rows = [r for _, r in reports if "radiance_vs_reference" in r]
+    if main_rows:
+        print("| scene, sky | points | Radiance mean / min lux, U | tool mean / min lux, U | "
+              "area-averaged | median point | Radiance one-run noise (area / median) | tool | "
+              "Radiance one run | ratio |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in main_rows:
         rg = r["radiance"]["grid"]
         nz = r["radiance"]["noise"]
-        noise_s = (f"{100 * nz['area_averaged']:.2f} % / {100 * nz['median_point']:.2f} %"
-                   if nz else "-")
+        noise_s = (f"{100 * nz['one_run_area_averaged']:.2f} % / "
+                   f"{100 * nz['one_run_median_point']:.2f} %" if nz else "-")
         rcell = f"{rg['mean_lux']:.0f} / {rg['min_lux']:.0f}, {rg['uniformity']:.2f}"
         if "figures" in r:
             tg, f = r["tool"]["grid"], r["figures"]
             tcell = f"{tg['mean_lux']:.0f} / {tg['min_lux']:.0f}, {tg['uniformity']:.2f}"
             cells = [tcell, f"{100 * f['area_averaged_relative_error']:.2f} %",
                      f"{100 * f['median_point_relative_error']:.2f} %", noise_s,
-                     f"{r['tool']['seconds']['solve']:.2f} s",
-                     f"{r['radiance']['seconds_one_run']:.0f} s",
+                     f"{f['tool_seconds']:.2f} s",
+                     f"{r['radiance']['seconds_one_run']:.1f} s",
                      f"{f['speed_ratio']:.0f}x" if f["speed_ratio"] else "-"]
         else:
-            cells = ["-", "-", "-", noise_s, "-", f"{r['radiance']['seconds_one_run']:.0f} s", "-"]
+            cells = ["-", "-", "-", noise_s, "-", f"{r['radiance']['seconds_one_run']:.1f} s",
+                     "-"]
         print(f"| {r['label']} | {r['points']} | {rcell} | " + " | ".join(cells) + " |")
+    if ref_rows:
+        if main_rows:
+            print()
+        print("| scene, sky | rtrace settings | against the reference: area-averaged | "
+              "median point | Radiance one run |")
+        print("|---|---|---|---|---|")
+    for r in ref_rows:
+        f = r["radiance_vs_reference"]
+        opts = r["radiance"]["rtrace"].split()
+        keep = []
+        for flag in ("-ab", "-ad", "-as", "-aa", "-ar"):
+            if flag in opts:
+                keep.append(f"{flag} {opts[opts.index(flag) + 1]}")
+        print(f"| {r['label']} | `{' '.join(keep)}` | "
+              f"{100 * f['area_averaged_relative_error']:.2f} % | "
+              f"{100 * f['median_point_relative_error']:.2f} % | "
+              f"{r['radiance']['seconds_one_run']:.2f} s |")
 
 
 if __name__ == "__main__":
