@@ -682,6 +682,12 @@ def main(argv=None):
                 "wall_seconds": wall, "lux": extra.get("lux"), "df": extra.get("df")}
         if tool["lux"] is None:
             sys.exit("the tool's grid.csv has no lux column")
+        sg = summary.get("grid") or {}
+        if sg.get("mean_lux") and abs(sg["mean_lux"] - tool["lux"].mean()) > 1e-3 * sg["mean_lux"]:
+            notes.append(f"summary.json grid mean_lux {sg['mean_lux']:.6g} is not the mean of "
+                         f"grid.csv's lux ({tool['lux'].mean():.6g})")
+        if sg.get("points") is not None and sg["points"] != len(tool["lux"]):
+            notes.append(f"summary.json grid points {sg['points']}, grid.csv {len(tool['lux'])}")
     else:
         sky = here_sky
 
@@ -725,7 +731,7 @@ def main(argv=None):
     cached = None
     if args.reuse and saved.is_file():
         cached = json.loads(saved.read_text())
-        if cached.get("key") != key:
+        if cached.get("key") != json.loads(json.dumps(key)):  # as JSON reads it back
             print(f"{saved}: made for other points, sky or settings; running Radiance")
             cached = None
     if cached is None:
