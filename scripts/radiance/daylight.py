@@ -254,17 +254,19 @@ def point_in_polygon(pts2, poly2) -> np.ndarray:
     return inside
 
 
-def make_grid(model, m: np.ndarray, height: float, spacing: float, floor_re: str):
+def make_grid(model, m: np.ndarray, height: float, spacing: float, floor_re: str,
+              levels=None):
     """The work plane, this script's rule: floors are faces whose material name matches
     ``floor_re`` (case-insensitive) and whose normal is within 8 degrees of the zenith; they
     are grouped into levels by height (1 cm); each level gets a square lattice in (east, north)
     at ``spacing``, starting half a spacing in from the level's bounding box, and keeps the
     lattice points that fall on one of its floor faces, lifted ``height`` along the zenith;
-    sensors face the zenith. Returns model-frame points and normals (points inside solids
-    are removed later by :func:`drop_inside`)."""
+    sensors face the zenith. ``levels``: indices of the levels kept (0 the lowest; None all).
+    Returns model-frame points and normals (points inside solids are removed later by
+    :func:`drop_inside`)."""
     up = m[2]
     rx = re.compile(floor_re, re.IGNORECASE)
-    levels = {}
+    levels_kept, levels = levels, {}
     for face, mi in zip(model.faces, model.face_material):
         if not rx.search(model.materials[mi].name):
             continue
@@ -275,7 +277,10 @@ def make_grid(model, m: np.ndarray, height: float, spacing: float, floor_re: str
         h = round(float(p.mean(axis=0) @ up), 2)
         levels.setdefault(h, []).append(p @ m[:2].T)  # 2D (east, north)
     pts, nrm = [], []
-    for h in sorted(levels):
+    heights = sorted(levels)
+    if levels_kept is not None:
+        heights = [h for k, h in enumerate(heights) if k in levels_kept]
+    for h in heights:
         polys = levels[h]
         allp = np.concatenate(polys)
         lo, hi = allp.min(axis=0), allp.max(axis=0)
@@ -616,6 +621,8 @@ def parse_args(argv=None):
                    help="HEIGHT,SPACING (m) or POINTS.csv (default 0.8,0.5)")
     ap.add_argument("--floor-material", default=r"^floor",
                     help="points-only grid: regex of the floor materials (default ^floor)")
+    ap.add_argument("--levels", help="points-only grid: the floor levels kept, as indices "
+                    "from the lowest (0), comma-separated (default all)")
     ap.add_argument("--tf-rule", choices=objrad.TF_RULES, default="contract",
                     help="how Tf 1 1 1 with d 1 reads (objrad.py); default contract: as Tf")
     ap.add_argument("--points-only", action="store_true",
@@ -707,14 +714,16 @@ def main(argv=None):
     if points_only:
         if re.fullmatch(r"[0-9.eE+-]+,[0-9.eE+-]+", args.grid):
             height, spacing = (float(x) for x in args.grid.split(","))
+            kept = [int(x) for x in args.levels.split(",")] if args.levels else None
             pts, nrm = make_grid(objrad.read_obj(model_path, tf_rule=args.tf_rule), m, height,
-                                 spacing, args.floor_material)
+                                 spacing, args.floor_material, kept)
             keep = drop_inside(rad, octree, model, pts @ m.T, normals_local)
             if (~keep).any():
                 notes.append(f"{int((~keep).sum())} grid points inside solids dropped")
             pts, nrm = pts[keep], nrm[keep]
             grid_rule = (f"work plane {height} m above faces of material /{args.floor_material}/"
-                         f" facing up, lattice {spacing} m (daylight.py make_grid)")
+                         f" facing up, lattice {spacing} m (daylight.py make_grid)"
+                         + (f", levels {args.levels}" if args.levels else ""))
         else:
             pts, nrm, _ = read_points_csv(Path(args.grid))
             grid_rule = f"points from {args.grid}"
