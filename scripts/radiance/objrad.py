@@ -8,6 +8,22 @@ reflectance rho is ``plastic`` with rho, no specularity; an emitter of radiance 
 with Ke (Radiance's ``light`` radiance is W/sr/m^2 too). Radiance's materials are two-sided, its
 lights one-sided (their backs are black), and ``light`` does not reflect: see
 :func:`write_rad` for emitters that also reflect.
+
+Glazing (issue 14): a material with transmission in its MTL passes light straight through with
+transmittance T: ``Tf r g b`` is T; without ``Tf``, ``d`` < 1 gives T = 1 - d, else ``Tr`` > 0
+gives T = Tr. Its ``Kd`` (rho) stays the pane's diffuse reflectance. In Radiance such a pane is
+``trans`` with no specular reflection (spec 0) and all its transmission specular (tspec 1): its
+diffuse reflectance is c (1 - t) and its straight-through transmittance c t, so c = rho + T and
+t = T / (rho + T) match the pane exactly (t is one number for the three channels: exact for grey
+panes, see :func:`trans_parameters`). ``glass`` would not do: it adds Fresnel reflection and its
+parameter is a transmissivity, not a transmittance. Radiance's shadow rays (the sun) and ambient
+rays go through ``trans`` straight on with factor c t (``scripts/radiance/README.md``,
+"Daylight", has the check).
+
+Many exporters write ``Tf 1 1 1`` with ``d 1`` for *opaque* materials (Sponza's and Sibenik's
+MTL do); read literally that is a fully transparent material. ``read_obj(...,
+tf_rule="opaque-d1")`` ignores ``Tf`` when the material also says ``d 1`` and no ``Tr`` above 0
+(a warning names such materials under either rule).
 """
 
 from __future__ import annotations
@@ -30,10 +46,19 @@ class Material:
     rho: tuple = (DEFAULT_GREY,) * 3
     ke: tuple = (0.0, 0.0, 0.0)
     rho_source: str = "default"
+    # Straight-through transmittance T per channel (0: opaque), and the MTL values it came from.
+    transmittance: tuple = (0.0, 0.0, 0.0)
+    tf: tuple | None = None
+    d: float | None = None
+    tr: float | None = None
 
     @property
     def emits(self) -> bool:
         return any(k > 0 for k in self.ke)
+
+    @property
+    def transmits(self) -> bool:
+        return any(t > 0 for t in self.transmittance)
 
 
 @dataclass
@@ -130,7 +155,56 @@ def find_file(folder: Path, name: str) -> Path:
     return folder / name
 
 
-def read_mtl(path: Path, warnings: list) -> dict:
+TF_RULES = ("contract", "opaque-d1")
+
+
+def numbers(rest: str) -> list:
+    """The words of a statement that read as numbers (options such as ``-halo`` or ``xyz``
+    skipped)."""
+    out = []
+    for w in rest.split():
+        try:
+            out.append(float(w))
+        except ValueError:
+            continue
+    return out
+
+
+def transmittance(m: Material, tf_rule: str, warnings: list) -> tuple:
+    """T per channel from the material's Tf / d / Tr (see the module docstring)."""
+    looks_opaque = (m.tf is not None and min(m.tf) >= 1.0 and m.d is not None and m.d >= 1.0
+                    and not (m.tr or 0.0) > 0.0)
+    if looks_opaque:
+        warnings.append(f"material {m.name!r}: Tf {' '.join(f'{x:g}' for x in m.tf)} with d 1 "
+                        + ("read as opaque (--tf-rule opaque-d1)" if tf_rule == "opaque-d1"
+                           else "read as fully transmissive (Tf is the transmittance)"))
+        if tf_rule == "opaque-d1":
+            return (0.0, 0.0, 0.0)
+    if m.tf is not None:
+        return tuple(min(max(x, 0.0), 1.0) for x in m.tf)
+    if m.d is not None and m.d < 1.0:
+        return (min(max(1.0 - m.d, 0.0), 1.0),) * 3
+    if m.tr is not None and m.tr > 0.0:
+        return (min(m.tr, 1.0),) * 3
+    return (0.0, 0.0, 0.0)
+
+
+def trans_parameters(rho, t):
+    """Radiance ``trans`` (colour c, transmissivity t_R, with spec 0 and tspec 1) for a pane of
+    diffuse reflectance ``rho`` and straight-through transmittance ``t`` per channel:
+    c = rho + T, t_R = T / (rho + T). t_R is one number: the luminance-weighted one when the
+    channels differ (then the match is not exact). Returns (c, t_R, exact)."""
+    c = tuple(r + x for r, x in zip(rho, t))
+    ratios = [x / ci if ci > 0 else 0.0 for x, ci in zip(t, c)]
+    w = (0.2126, 0.7152, 0.0722)
+    num = sum(wi * x for wi, x in zip(w, t))
+    den = sum(wi * ci for wi, ci in zip(w, c))
+    t_r = num / den if den > 0 else 0.0
+    exact = max(ratios) - min(ratios) < 1e-9
+    return c, t_r, exact
+
+
+def read_mtl(path: Path, warnings: list, tf_rule: str = "contract") -> dict:
     """Materials by name from one MTL file."""
     mats, cur, tex = {}, None, {}
     kd_seen = {}
@@ -148,6 +222,18 @@ def read_mtl(path: Path, warnings: list) -> dict:
             kd_seen[cur.name] = True
         elif word == "Ke":
             cur.ke = tuple(float(x) for x in rest.split()[:3])
+        elif word == "Tf":
+            vals = numbers(rest)[:3]
+            if vals:
+                cur.tf = tuple((vals * 3)[:3]) if len(vals) < 3 else tuple(vals)
+        elif word == "d":
+            vals = numbers(rest)
+            if vals:
+                cur.d = vals[0]
+        elif word == "Tr":
+            vals = numbers(rest)
+            if vals:
+                cur.tr = vals[0]
         elif word == "map_Kd":
             tex[cur.name] = map_file(rest)
     for name, file in tex.items():
@@ -163,12 +249,13 @@ def read_mtl(path: Path, warnings: list) -> dict:
         if any(r >= 1.0 for r in m.rho):
             m.rho = tuple(MAX_REFLECTANCE if r >= 1.0 else r for r in m.rho)
             m.rho_source += " clamped"
+        m.transmittance = transmittance(m, tf_rule, warnings)
     return mats
 
 
-def read_obj(path: Path, emit: dict | None = None) -> Model:
+def read_obj(path: Path, emit: dict | None = None, tf_rule: str = "contract") -> Model:
     """An OBJ file with its MTL libraries; ``emit`` maps material names to Ke (the tool's
-    ``--emit``)."""
+    ``--emit``); ``tf_rule`` how Tf 1 1 1 with d 1 reads (:data:`TF_RULES`)."""
     path = Path(path)
     warnings: list = []
     verts, faces, face_mat = [], [], []
@@ -202,7 +289,7 @@ def read_obj(path: Path, emit: dict | None = None) -> Model:
             for n in cands:
                 p = path.parent / n
                 if p.is_file():
-                    lib.update(read_mtl(p, warnings))
+                    lib.update(read_mtl(p, warnings, tf_rule))
                 else:
                     warnings.append(f"material library {n!r} missing")
     nv = len(verts)
@@ -257,6 +344,13 @@ def write_rad(model: Model, path: Path, light_radiance: dict | None = None):
         if m.emits:
             out.append(f"# {m.name}: Ke {m.ke} (W/sr/m^2), rho {m.rho} (not reflected by light)")
             out.append(f"void light m{k}\n0\n0\n3 {m.ke[0]:.9g} {m.ke[1]:.9g} {m.ke[2]:.9g}")
+        elif m.transmits:
+            c, t_r, exact = trans_parameters(m.rho, m.transmittance)
+            out.append(f"# {m.name}: rho {m.rho}, straight-through T {m.transmittance}: trans "
+                       f"c = rho + T, t = T / (rho + T), spec 0, tspec 1"
+                       + ("" if exact else " (not exact: T / (rho + T) differs by channel)"))
+            out.append(f"void trans m{k}\n0\n0\n7 {c[0]:.9g} {c[1]:.9g} {c[2]:.9g} 0 0 "
+                       f"{t_r:.9g} 1")
         else:
             out.append(f"# {m.name}: rho {m.rho} ({m.rho_source})")
             out.append(f"void plastic m{k}\n0\n0\n5 {m.rho[0]:.9g} {m.rho[1]:.9g} "
