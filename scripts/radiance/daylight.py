@@ -664,8 +664,8 @@ def parse_args(argv=None):
                     help="points-only grid: regex of the floor materials (default ^floor)")
     ap.add_argument("--levels", help="points-only grid: the floor levels kept, as indices "
                     "from the lowest (0), comma-separated (default all)")
-    ap.add_argument("--tf-rule", choices=objrad.TF_RULES, default="contract",
-                    help="how Tf 1 1 1 with d 1 reads (objrad.py); default contract: as Tf")
+    ap.add_argument("--tf-rule", choices=objrad.TF_RULES, default="tool",
+                    help="how Tf / d / Tr / illum read (objrad.py): the tool's rule")
     ap.add_argument("--points-only", action="store_true",
                     help="run Radiance alone on a grid made here (automatic when the tool does "
                     "not know --sky)")

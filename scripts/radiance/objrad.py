@@ -10,20 +10,18 @@ lights one-sided (their backs are black), and ``light`` does not reflect: see
 :func:`write_rad` for emitters that also reflect.
 
 Glazing (issue 14): a material with transmission in its MTL passes light straight through with
-transmittance T: ``Tf r g b`` is T; without ``Tf``, ``d`` < 1 gives T = 1 - d, else ``Tr`` > 0
-gives T = Tr. Its ``Kd`` (rho) stays the pane's diffuse reflectance. In Radiance such a pane is
+transmittance T, read by the tool's rule (``src/scene/obj/mtl.rs``, ``transmittance``): ``d`` < 1
+(or ``Tr`` > 0 without ``d``) gives T = (1 - d) x mean ``Tf`` (1 without ``Tf``); else a
+transparency ``illum`` (4, 6, 7, 9) with ``Tf`` gives T = mean ``Tf``; else a ``Tf`` strictly
+between 0 and 1 in some channel gives T = mean ``Tf``; else opaque (exporters write ``Tf 1 1 1``
+with ``d 1`` on opaque materials: Sponza's and Sibenik's MTL do). T is grey, and at most
+1 - max rho. Its ``Kd`` (rho) stays the pane's diffuse reflectance. In Radiance such a pane is
 ``trans`` with no specular reflection (spec 0) and all its transmission specular (tspec 1): its
 diffuse reflectance is c (1 - t) and its straight-through transmittance c t, so c = rho + T and
-t = T / (rho + T) match the pane exactly (t is one number for the three channels: exact for grey
-panes, see :func:`trans_parameters`). ``glass`` would not do: it adds Fresnel reflection and its
-parameter is a transmissivity, not a transmittance. Radiance's shadow rays (the sun) and ambient
-rays go through ``trans`` straight on with factor c t (``scripts/radiance/README.md``,
-"Daylight", has the check).
-
-Many exporters write ``Tf 1 1 1`` with ``d 1`` for *opaque* materials (Sponza's and Sibenik's
-MTL do); read literally that is a fully transparent material. ``read_obj(...,
-tf_rule="opaque-d1")`` ignores ``Tf`` when the material also says ``d 1`` and no ``Tr`` above 0
-(a warning names such materials under either rule).
+t = T / (rho + T) match the pane exactly (see :func:`trans_parameters`). ``glass`` would not do:
+it adds Fresnel reflection and its parameter is a transmissivity, not a transmittance.
+Radiance's shadow rays (the sun) and ambient rays go through ``trans`` straight on with factor
+c t (``scripts/radiance/README.md``, "Daylight", has the check).
 """
 
 from __future__ import annotations
@@ -51,6 +49,7 @@ class Material:
     tf: tuple | None = None
     d: float | None = None
     tr: float | None = None
+    illum: int | None = None
 
     @property
     def emits(self) -> bool:
@@ -155,7 +154,7 @@ def find_file(folder: Path, name: str) -> Path:
     return folder / name
 
 
-TF_RULES = ("contract", "opaque-d1")
+TF_RULES = ("tool",)
 
 
 def numbers(rest: str) -> list:
@@ -171,22 +170,23 @@ def numbers(rest: str) -> list:
 
 
 def transmittance(m: Material, tf_rule: str, warnings: list) -> tuple:
-    """T per channel from the material's Tf / d / Tr (see the module docstring)."""
-    looks_opaque = (m.tf is not None and min(m.tf) >= 1.0 and m.d is not None and m.d >= 1.0
-                    and not (m.tr or 0.0) > 0.0)
-    if looks_opaque:
-        warnings.append(f"material {m.name!r}: Tf {' '.join(f'{x:g}' for x in m.tf)} with d 1 "
-                        + ("read as opaque (--tf-rule opaque-d1)" if tf_rule == "opaque-d1"
-                           else "read as fully transmissive (Tf is the transmittance)"))
-        if tf_rule == "opaque-d1":
-            return (0.0, 0.0, 0.0)
-    if m.tf is not None:
-        return tuple(min(max(x, 0.0), 1.0) for x in m.tf)
-    if m.d is not None and m.d < 1.0:
-        return (min(max(1.0 - m.d, 0.0), 1.0),) * 3
-    if m.tr is not None and m.tr > 0.0:
-        return (min(m.tr, 1.0),) * 3
-    return (0.0, 0.0, 0.0)
+    """T (grey, per channel) from the material's Tf / d / Tr / illum, the tool's rule (see the
+    module docstring); ``tf_rule`` is kept for the command line and must be "tool"."""
+    mean = (lambda c: sum(c) / 3.0)
+    opacity = m.d if m.d is not None else (1.0 - m.tr if m.tr is not None else None)
+    if opacity is not None and opacity < 1.0:
+        t = (1.0 - opacity) * (mean(m.tf) if m.tf is not None else 1.0)
+    elif m.tf is not None and m.illum in (4, 6, 7, 9):
+        t = mean(m.tf)
+    elif m.tf is not None and any(0.0 < x < 1.0 for x in m.tf):
+        t = mean(m.tf)
+    else:
+        t = 0.0
+    room = max(0.0, 1.0 - max(m.rho))
+    if t > room:
+        warnings.append(f"material {m.name!r}: transmittance {t:g} cut to {room:g} (rho + T <= 1)")
+        t = room
+    return (t, t, t)
 
 
 def trans_parameters(rho, t):
@@ -204,7 +204,7 @@ def trans_parameters(rho, t):
     return c, t_r, exact
 
 
-def read_mtl(path: Path, warnings: list, tf_rule: str = "contract") -> dict:
+def read_mtl(path: Path, warnings: list, tf_rule: str = "tool") -> dict:
     """Materials by name from one MTL file."""
     mats, cur, tex = {}, None, {}
     kd_seen = {}
@@ -230,6 +230,10 @@ def read_mtl(path: Path, warnings: list, tf_rule: str = "contract") -> dict:
             vals = numbers(rest)
             if vals:
                 cur.d = vals[0]
+        elif word == "illum":
+            vals = numbers(rest)
+            if vals:
+                cur.illum = int(vals[0])
         elif word == "Tr":
             vals = numbers(rest)
             if vals:
@@ -253,9 +257,9 @@ def read_mtl(path: Path, warnings: list, tf_rule: str = "contract") -> dict:
     return mats
 
 
-def read_obj(path: Path, emit: dict | None = None, tf_rule: str = "contract") -> Model:
+def read_obj(path: Path, emit: dict | None = None, tf_rule: str = "tool") -> Model:
     """An OBJ file with its MTL libraries; ``emit`` maps material names to Ke (the tool's
-    ``--emit``); ``tf_rule`` how Tf 1 1 1 with d 1 reads (:data:`TF_RULES`)."""
+    ``--emit``); ``tf_rule``: the tool's glazing rule (:data:`TF_RULES`)."""
     path = Path(path)
     warnings: list = []
     verts, faces, face_mat = [], [], []
