@@ -71,7 +71,7 @@ pub fn run_reference(job: &ReferenceJob, mut log: impl FnMut(&str)) -> Result<Re
         }
     })?;
     write_atomic(&job.out.join("patches.csv"), |w| {
-        patches::write(w, m, &scene.materials, &r.b)
+        patches::write(w, m, &scene.materials, &r.b, None)
     })?;
     let summary = ReferenceSummary {
         version: env!("CARGO_PKG_VERSION"),
@@ -284,7 +284,7 @@ pub fn run_compare(job: &CompareJob, mut log: impl FnMut(&str)) -> Result<Compar
             let dir = job.out.join("reference");
             export::prepare_dir(&dir)?;
             write_atomic(&dir.join("patches.csv"), |w| {
-                patches::write(w, m, &scene.materials, &r.b)
+                patches::write(w, m, &scene.materials, &r.b, None)
             })?;
             let b = r.b.clone();
             (b, Some(r), "built here (reference/patches.csv)".to_string())

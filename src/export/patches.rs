@@ -1,22 +1,51 @@
 //! The patch table (docs/design.md §5): one CSV row per patch, stable ids in mesh order,
 //! `id, cx, cy, cz, nx, ny, nz, area, rho_r, rho_g, rho_b, e_r, e_g, e_b, b_r, b_g, b_b`
-//! (B = radiosity in W/m²; irradiance = (B − E)/ρ).
+//! (B = radiosity in W/m²; irradiance = (B − E)/ρ), then (issue 14) `lux, df`: the
+//! illuminance in lux (179 lm/W × the luminance-weighted irradiance, over the channels with
+//! ρ > 0; empty where the material reflects nothing, so its irradiance is unknown from B) and
+//! the daylight factor in % (lux over the sky's unobstructed horizontal illuminance, sun
+//! included; empty without a sky).
 
 use crate::mesh::Mesh;
 use crate::scene::Material;
 use std::io::{self, BufRead, Write};
 
-/// The header, exactly as other tools script against it.
+/// The header's first 17 columns, exactly as other tools script against them.
 pub const HEADER: &str = "id,cx,cy,cz,nx,ny,nz,area,rho_r,rho_g,rho_b,e_r,e_g,e_b,b_r,b_g,b_b";
+/// The columns added after them (issue 14).
+pub const DAYLIGHT_COLUMNS: &str = "lux,df";
 
-/// Writes the table. Non-finite values never reach the file: they are an error.
+/// Luminance weights of the RGB channels (Rec. 709), for illuminance from RGB irradiance.
+pub const LUMA: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
+/// Illuminance in lux of a patch of material `m` and radiosity `b`: 179 lm/W × the
+/// luminance-weighted irradiance (B − E)/ρ over the channels with ρ > 0; `None` when no
+/// channel reflects.
+pub fn lux(m: &Material, b: &[f64; 3]) -> Option<f64> {
+    let e = m.emission();
+    let (mut sum, mut w) = (0.0, 0.0);
+    for c in 0..3 {
+        if m.rho[c] > 0.0 {
+            sum += LUMA[c] * (b[c] - e[c]) / m.rho[c];
+            w += LUMA[c];
+        }
+    }
+    (w > 0.0)
+        .then(|| crate::sky::EFFICACY * (sum / w).max(0.0))
+        .filter(|h| h.is_finite())
+}
+
+/// Writes the table. `sky_lux` is the sky's unobstructed horizontal illuminance (sun
+/// included) when there is a sky, for the daylight factor. Non-finite values never reach the
+/// file: they are an error.
 pub fn write(
     w: &mut dyn Write,
     mesh: &Mesh,
     materials: &[Material],
     b: &[[f64; 3]],
+    sky_lux: Option<f64>,
 ) -> io::Result<()> {
-    writeln!(w, "{HEADER}")?;
+    writeln!(w, "{HEADER},{DAYLIGHT_COLUMNS}")?;
     for (i, p) in mesh.patches.iter().enumerate() {
         let m = &materials[p.material as usize];
         let e = m.emission();
@@ -47,7 +76,10 @@ pub fn write(
         for v in vals {
             write!(w, ",{v}")?;
         }
-        writeln!(w)?;
+        let lx = lux(m, &b[i]);
+        let df = lx.zip(sky_lux.filter(|s| *s > 0.0)).map(|(l, s)| 100.0 * l / s);
+        let opt = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
+        writeln!(w, ",{},{}", opt(lx), opt(df))?;
     }
     Ok(())
 }
@@ -77,7 +109,8 @@ pub fn read(r: impl BufRead) -> io::Result<Vec<Row>> {
     for (k, line) in r.lines().enumerate() {
         let line = line?;
         if k == 0 {
-            if line.trim() != HEADER {
+            // Tables written before the daylight columns end at HEADER.
+            if !line.trim().starts_with(HEADER) {
                 return Err(bad(1, "not a patch table (unexpected header)"));
             }
             continue;

@@ -71,7 +71,17 @@ pub fn write(
         written.push(path);
     };
     let csv = job.out.join("patches.csv");
-    write_atomic(&csv, |w| patches::write(w, m, &scene.materials, &sol.b))?;
+    let sky_lux = job
+        .settings
+        .solve
+        .sky
+        .as_ref()
+        .and_then(|s| crate::sky::Sky::new(s).ok())
+        .map(|s| {
+            let (sky, sun) = s.horizontal_illuminance();
+            sky + sun
+        });
+    write_atomic(&csv, |w| patches::write(w, m, &scene.materials, &sol.b, sky_lux))?;
     wrote(csv);
     let trace_csv = job.out.join("trace.csv");
     write_atomic(&trace_csv, |w| report::trace::write(w, &sol.stats.trace))?;
