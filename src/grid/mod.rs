@@ -14,7 +14,7 @@
 //!
 //! The results go to `grid.csv` ([`write_csv`]: `x,y,z,nx,ny,nz,lux,df`), `summary.json`
 //! ([`GridStats`]: mean, minimum, uniformity U0 = min/mean, …) and a false-colour plan
-//! (the plan (`plan_image`, to come): one top view per storey, a legend in lux, north up).
+//! ([`plan_image`]: one top view per storey, a legend in lux, north up).
 //!
 //! **Orientation.** Plans are laid out in the sky's frame ([`Frame`]: east = north × zenith),
 //! so the grid and the sky can never disagree about which way is north. Coordinates are model
@@ -25,10 +25,13 @@
 //! draws one panel per storey.
 
 mod csv;
+mod plan;
+mod spacing;
 mod stats;
 pub mod work_plane;
 
 pub use csv::{read_points, write_csv, CSV_HEADER};
+pub use plan::plan_image;
 pub use stats::{stats, GridStats};
 pub use work_plane::{work_plane, MAX_COLUMNS, MIN_STOREY_CLEARANCE};
 
@@ -77,7 +80,7 @@ impl GridSpec {
         }
     }
 
-    /// The cell size the plan (`plan_image`, to come) should draw: the lattice spacing, or 0 (estimate it) for
+    /// The cell size [`plan_image`] should draw: the lattice spacing, or 0 (estimate it) for
     /// points from a file.
     pub fn spacing_hint(&self) -> f32 {
         match self {
