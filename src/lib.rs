@@ -20,7 +20,8 @@
 //! relight), [`compare`] (reference and methods side by side), [`bench`](mod@bench) (benchmarks,
 //! cross-checks and the scene-size sweep), [`render`] (rasteriser, false colour, glyphs),
 //! [`export`] (file formats), [`report`] (summaries, traces, plots), [`generate`] (generated
-//! buildings). The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
+//! buildings), [`grid`] (the sensor grid of a daylight study: placement, CSV, figures, plan).
+//! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
 pub mod bench;
@@ -28,6 +29,7 @@ pub mod compare;
 pub mod error;
 pub mod export;
 pub mod generate;
+pub mod grid;
 pub mod intersect;
 pub mod mesh;
 pub mod model;

@@ -181,19 +181,20 @@ pub fn render(
         });
         img.put_pixel(k as u32 % w, k as u32 / w, image::Rgb(px));
     }
-    draw_legend(&mut img, w, &scale);
+    draw_legend(&mut img, w, &scale, "W/m2");
     (img, scale)
 }
 
-/// The legend: a vertical colour bar, its 1–2–5 ticks labelled, and the unit on top.
-fn draw_legend(img: &mut image::RgbImage, x0: u32, scale: &Scale) {
+/// The legend: a vertical colour bar, its 1–2–5 ticks labelled, and the unit on top, in a panel
+/// of [`LEGEND_WIDTH`] from column `x0` (the grid's plan draws it too, in lux).
+pub(crate) fn draw_legend(img: &mut image::RgbImage, x0: u32, scale: &Scale, unit: &str) {
     let ht = img.height() as i64;
     let font = if ht >= 240 { 2 } else { 1 };
     let ink = [230, 230, 230];
     let fh = (glyphs::HEIGHT * font) as i64;
     let top = 8 + fh + 8;
     let bottom = ht - 8 - fh / 2;
-    glyphs::draw(img, x0 as i64 + 10, 8, font, "W/m2", ink);
+    glyphs::draw(img, x0 as i64 + 10, 8, font, unit, ink);
     if bottom - top < 8 {
         return;
     }

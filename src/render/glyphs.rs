@@ -1,5 +1,6 @@
 //! A tiny built-in bitmap font for the labels of image legends: digits and the few letters
-//! numbers and their unit need (`.`, `-`, `k`, `W`, `/`, `m`), 5 pixels high. Enough to label a
+//! numbers and their units need (`.`, `-`, `+`, `k`, `W`, `/`, `m`, `lux`, and `N` for north),
+//! 5 pixels high. Enough to label a
 //! colour scale without a font file or a text-rendering crate.
 
 /// The rows of a glyph, top to bottom, `#` for ink; `None` for characters it lacks.
@@ -21,6 +22,12 @@ fn glyph(c: char) -> Option<[&'static str; 5]> {
         'W' => ["#...#", "#...#", "#.#.#", "#.#.#", ".#.#."],
         '/' => ["..#", "..#", ".#.", "#..", "#.."],
         'm' => [".....", "####.", "#.#.#", "#.#.#", "#.#.#"],
+        // For the grid's plan (src/grid): "lux", "+3.0 m", the north marker.
+        'l' => ["#.", "#.", "#.", "#.", ".#"],
+        'u' => ["...", "#.#", "#.#", "#.#", "###"],
+        'x' => ["...", "#.#", ".#.", ".#.", "#.#"],
+        '+' => ["...", ".#.", "###", ".#.", "..."],
+        'N' => ["#...#", "##..#", "#.#.#", "#..##", "#...#"],
         ' ' => ["..", "..", "..", "..", ".."],
         _ => return None,
     })
@@ -74,7 +81,7 @@ mod tests {
 
     #[test]
     fn glyphs_are_rectangular() {
-        for c in "0123456789.-kW/m ".chars() {
+        for c in "0123456789.-kW/m lux+N".chars() {
             let g = glyph(c).unwrap();
             assert!(g.iter().all(|r| r.len() == g[0].len()), "{c}");
         }
