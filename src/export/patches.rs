@@ -77,7 +77,9 @@ pub fn write(
             write!(w, ",{v}")?;
         }
         let lx = lux(m, &b[i]);
-        let df = lx.zip(sky_lux.filter(|s| *s > 0.0)).map(|(l, s)| 100.0 * l / s);
+        let df = lx
+            .zip(sky_lux.filter(|s| *s > 0.0))
+            .map(|(l, s)| 100.0 * l / s);
         let opt = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
         writeln!(w, ",{},{}", opt(lx), opt(df))?;
     }

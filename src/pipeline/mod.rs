@@ -8,6 +8,7 @@
 //!   checkpoints, resume, Ctrl-C).
 //! - [`outputs`]: the files a solve writes.
 
+pub mod daylight;
 pub mod hooks;
 pub mod outputs;
 
@@ -99,6 +100,10 @@ pub struct SolveJob {
     pub resume: Option<PathBuf>,
     /// Set on Ctrl-C: stop at the next safe point.
     pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Sensors to measure (`--grid`, issue 14): `grid.csv`, `grid.png`, the summary's `grid`.
+    pub grid: Option<crate::grid::GridSpec>,
+    /// Rays each sensor gathers (`--grid-rays`).
+    pub grid_rays: usize,
 }
 
 /// Seconds between checkpoints by default (`--checkpoint-every`).
@@ -118,6 +123,8 @@ impl SolveJob {
             checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
             resume: None,
             interrupt: None,
+            grid: None,
+            grid_rays: daylight::DEFAULT_GRID_RAYS,
         }
     }
 

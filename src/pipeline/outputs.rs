@@ -81,8 +81,42 @@ pub fn write(
             let (sky, sun) = s.horizontal_illuminance();
             sky + sun
         });
-    write_atomic(&csv, |w| patches::write(w, m, &scene.materials, &sol.b, sky_lux))?;
+    write_atomic(&csv, |w| {
+        patches::write(w, m, &scene.materials, &sol.b, sky_lux)
+    })?;
     wrote(csv);
+    let mut grid_seconds = 0.0;
+    let grid = match &job.grid {
+        Some(spec) => {
+            let tg = Instant::now();
+            let g = measure_grid(job, run, spec)?;
+            grid_seconds = tg.elapsed().as_secs_f64();
+            let grid_csv = job.out.join("grid.csv");
+            crate::grid::write_csv(&grid_csv, &g.sensors, &g.lux, &g.df).map_err(|source| {
+                crate::export::WriteError {
+                    path: grid_csv.clone(),
+                    source,
+                }
+            })?;
+            wrote(grid_csv);
+            let plan = job.out.join("grid.png");
+            let img = crate::grid::plan_image(
+                &g.sensors,
+                &g.lux,
+                &frame_of(job),
+                spec.spacing_hint(),
+                super::daylight::PLAN_WIDTH,
+            );
+            write_png(&plan, &img)?;
+            wrote(plan);
+            log(&format!(
+                "grid: {} sensors, mean {:.0} lux, min {:.0} lux, uniformity {:.2}, mean daylight factor {:.2} %",
+                g.stats.points, g.stats.mean_lux, g.stats.min_lux, g.stats.uniformity, g.stats.mean_df
+            ));
+            Some(g.stats)
+        }
+        None => None,
+    };
     let trace_csv = job.out.join("trace.csv");
     write_atomic(&trace_csv, |w| report::trace::write(w, &sol.stats.trace))?;
     wrote(trace_csv);
@@ -90,12 +124,7 @@ pub fn write(
     let png = job.out.join("render.png");
     let (lo, hi) = scene.bounds();
     let img = render_solution(m, &sol.b, &job.view.camera_for(lo, hi), &job.view.image);
-    write_atomic(&png, |w| {
-        let mut buf = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut buf, image::ImageFormat::Png)
-            .map_err(std::io::Error::other)?;
-        w.write_all(buf.get_ref())
-    })?;
+    write_png(&png, &img)?;
     wrote(png);
     if let Some(save) = &job.save {
         save_solution(save, job, model, sol)?;
@@ -122,8 +151,14 @@ pub fn write(
     outputs.push(json.display().to_string());
     let mut timings = run.timings.clone();
     timings.output = t.elapsed().as_secs_f64();
+    timings.grid = grid_seconds;
     timings.total = run.t0.elapsed().as_secs_f64();
-    let summary = summary(job, run, timings, energy, warnings, outputs);
+    let mut summary = summary(job, run, timings, energy, warnings, outputs);
+    summary.grid = grid;
+    summary.sky = job.settings.solve.sky.as_ref().and_then(|spec| {
+        let sky = crate::sky::Sky::new(spec).ok()?;
+        Some(super::daylight::SkyReport::new(spec, &sky))
+    });
     write_atomic(&json, |w| {
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
         writeln!(w)
@@ -188,7 +223,63 @@ fn summary(
         outputs,
         settings: job.settings.to_json(),
         trace: sol.stats.trace.clone(),
+        sky: None,
+        grid: None,
     }
+}
+
+/// Writes a PNG atomically.
+fn write_png(path: &std::path::Path, img: &image::RgbImage) -> Result<(), Error> {
+    write_atomic(path, |w| {
+        let mut buf = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut buf, image::ImageFormat::Png)
+            .map_err(std::io::Error::other)?;
+        w.write_all(buf.get_ref())
+    })?;
+    Ok(())
+}
+
+/// The model's orientation: the sky's zenith and north, else the defaults (Y up, north −Z).
+fn frame_of(job: &SolveJob) -> crate::sky::Frame {
+    let (z, n) = job.settings.solve.sky.as_ref().map_or(
+        (crate::sky::DEFAULT_ZENITH, crate::sky::DEFAULT_NORTH),
+        |s| (s.zenith, s.north),
+    );
+    crate::sky::Frame::new(z, n).unwrap_or_else(|_| {
+        crate::sky::Frame::new(crate::sky::DEFAULT_ZENITH, crate::sky::DEFAULT_NORTH)
+            .expect("the default frame is valid")
+    })
+}
+
+/// The grid's sensors measured on the solution (they need the rays' intersector).
+fn measure_grid(
+    job: &SolveJob,
+    run: &Run,
+    spec: &crate::grid::GridSpec,
+) -> Result<super::daylight::GridResult, Error> {
+    let Some((isect, _)) = run.isect else {
+        return Err(Error::Invalid(
+            "--grid needs a method that casts rays (adaptive-hybrid or adaptive-rays)".into(),
+        ));
+    };
+    let sky = job
+        .settings
+        .solve
+        .sky
+        .as_ref()
+        .and_then(|s| crate::sky::Sky::new(s).ok());
+    super::daylight::measure(
+        spec,
+        &run.model.mesh,
+        &run.model.scene.materials,
+        isect,
+        &run.sol.b,
+        sky.as_ref(),
+        &frame_of(job),
+        job.grid_rays,
+        job.settings.solve.seed,
+    )
+    .map_err(|e| Error::Invalid(e.to_string()))
 }
 
 /// Scalar flux the lights emit (W): what the solve's progress is measured against.

@@ -208,6 +208,8 @@ pub struct Timings {
     pub build: f64,
     pub solve: f64,
     pub output: f64,
+    /// Of `output`: measuring the sensor grid (`--grid`).
+    pub grid: f64,
     pub total: f64,
 }
 
@@ -292,6 +294,12 @@ pub struct Summary {
     pub settings: serde_json::Value,
     /// The max-unshot trace, against time and shots.
     pub trace: Vec<TracePoint>,
+    /// The sky (issue 14), when the solve had one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sky: Option<crate::pipeline::daylight::SkyReport>,
+    /// The sensor grid's statistics (`--grid`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grid: Option<crate::grid::GridStats>,
 }
 
 impl Summary {

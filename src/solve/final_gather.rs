@@ -80,6 +80,8 @@ use std::time::Instant;
 
 /// The "shot number" the gather's random numbers are drawn under (never a real shot's).
 pub const GATHER_STREAM: u64 = u64::MAX - 1;
+/// The stream of the sensors' gathers.
+pub const SENSOR_STREAM: u64 = u64::MAX - 3;
 
 /// What the final gather did (`summary.json`: `final_gather`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -146,6 +148,9 @@ struct Traced {
     panes: [f64; 3],
 }
 
+/// The "patch" a sensor's rays leave: none (a point in the air).
+pub const NO_PATCH: usize = usize::MAX;
+
 /// Surfaces a gather ray may step past (its own, glazing) before it is taken as lost.
 const MAX_STEPS: usize = 16;
 
@@ -155,6 +160,107 @@ struct Reflected {
     v: [f64; 3],
     ch: Vec<[f64; 3]>,
     rays: u64,
+}
+
+/// The solution a gather reads.
+struct Inputs<'a> {
+    e: &'a [[f64; 3]],
+    rho: &'a [[f64; 3]],
+    b: &'a [[f64; 3]],
+    channels: &'a [LightChannel],
+    group: Option<&'a [u32]>,
+}
+
+impl<'a, I: Intersector> Ctx<'a, I> {
+    fn new(
+        mesh: &'a Mesh,
+        materials: &[Material],
+        isect: &'a I,
+        inputs: Inputs<'a>,
+        seed: u64,
+        rays: usize,
+        sky: Option<&'a Sky>,
+    ) -> Self {
+        // Emitters by scalar power; a back twin emits from the back of its surface.
+        let (mut emitters, mut cdf, mut power) = (Vec::new(), Vec::new(), 0.0);
+        for (i, p) in mesh.patches.iter().enumerate() {
+            let w = scalar(&inputs.e[i]) * p.area;
+            if w > 0.0 {
+                power += w;
+                emitters.push(i);
+                cdf.push(power);
+            }
+        }
+        let reach = mesh
+            .vertices
+            .iter()
+            .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+        let t = |p: &crate::mesh::Patch| materials[p.material as usize].transmittance;
+        Ctx {
+            mesh,
+            isect,
+            emitter_points: emitters
+                .iter()
+                .map(|&j| PatchPoints::new(mesh, j))
+                .collect(),
+            e: inputs.e,
+            rho: inputs.rho,
+            b: inputs.b,
+            channels: inputs.channels,
+            group: inputs.group,
+            emitters,
+            cdf,
+            power,
+            eps_floor: reach * 5e-7,
+            seed,
+            rays: rays.max(4),
+            sky,
+            trans: if materials.iter().any(|m| m.transmittance > 0.0) {
+                mesh.patches.iter().map(t).collect()
+            } else {
+                Vec::new()
+            },
+        }
+    }
+}
+
+/// Irradiance (RGB, W/m²) at sensors (point, facing direction) from the solved radiosity `b`
+/// (issue 14's grid): each sensor gathers as a patch does ([`Ctx::gather_at`]: light samples of
+/// the emitters and the sun, hemisphere rays that see the solution, the sky and through
+/// glazing, near hits followed), `rays` rays each; reproducible for `seed`.
+#[allow(clippy::too_many_arguments)]
+pub fn sensor_irradiance<I: Intersector>(
+    mesh: &Mesh,
+    materials: &[Material],
+    isect: &I,
+    b: &[[f64; 3]],
+    sky: Option<&Sky>,
+    sensors: &[(Vec3, Vec3)],
+    rays: usize,
+    seed: u64,
+) -> Vec<[f64; 3]> {
+    let mat = |i: usize| &materials[mesh.patches[i].material as usize];
+    let e: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).emission()).collect();
+    let rho: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).rho).collect();
+    let inputs = Inputs {
+        e: &e,
+        rho: &rho,
+        b,
+        channels: &[],
+        group: None,
+    };
+    let ctx = Ctx::new(mesh, materials, isect, inputs, seed, rays, sky);
+    sensors
+        .par_iter()
+        .enumerate()
+        .map(|(k, &(x, n))| {
+            let mut rng = rng_for(seed, SENSOR_STREAM, k as u64);
+            let n = n.normalize_or_zero();
+            let at = |_: f32, _: f32| x;
+            ctx.gather_at(NO_PATCH, &at, n, ctx.eps_floor, [1.0; 3], &mut rng)
+                .h
+        })
+        .collect()
 }
 
 /// One patch's gather: irradiance H (RGB), per channel, the scalar variance of ρ·H's mean.
@@ -213,7 +319,7 @@ impl<I: Intersector> Ctx<'_, I> {
     /// (B − E, times the transmittance of the panes before it) and passes on its transmittance
     /// T; the ray goes on to the first opaque surface.
     fn cast(&self, i: usize, mut ray: Ray, eps: f32) -> Traced {
-        let own = self.mesh.surface_of(i);
+        let own = (i != NO_PATCH).then(|| self.mesh.surface_of(i));
         let mut out = Traced {
             hit: None,
             through: 1.0,
@@ -221,7 +327,7 @@ impl<I: Intersector> Ctx<'_, I> {
         };
         for _ in 0..MAX_STEPS {
             match self.isect.intersect(&ray) {
-                Some(h) if h.patch as usize == own => ray.tnear = h.t + eps,
+                Some(h) if Some(h.patch as usize) == own => ray.tnear = h.t + eps,
                 Some(h) if self.trans.get(h.patch as usize).is_some_and(|t| *t > 0.0) => {
                     if let Some(r) = self.mesh.receiver(h.patch, h.back) {
                         let r = r as usize;
@@ -244,14 +350,28 @@ impl<I: Intersector> Ctx<'_, I> {
     }
 
     fn gather(&self, i: usize) -> Gathered {
-        let mesh = self.mesh;
-        let patch = &mesh.patches[i];
-        let n = patch.normal;
-        let k = self.channels.len();
+        let patch = &self.mesh.patches[i];
         let eps = (1e-4 * (patch.area as f32).sqrt()).max(self.eps_floor);
-        let points = PatchPoints::new(mesh, i);
+        let points = PatchPoints::new(self.mesh, i);
         let mut rng = rng_for(self.seed, GATHER_STREAM, i as u64);
-        let rho = self.rho[i];
+        let at = |u: f32, v: f32| points.at(u, v);
+        self.gather_at(i, &at, patch.normal, eps, self.rho[i], &mut rng)
+    }
+
+    /// The gather at the points `at(u, v)` of the unit square's map (a patch's, or one
+    /// sensor's point) facing `n`, rays leaving patch `i`'s surface ([`NO_PATCH`] for a
+    /// sensor in the air); `rho` weighs the channels of the variance.
+    fn gather_at<R: Rng>(
+        &self,
+        i: usize,
+        at: &dyn Fn(f32, f32) -> Vec3,
+        n: Vec3,
+        eps: f32,
+        rho: [f64; 3],
+        rng: &mut R,
+    ) -> Gathered {
+        let mesh = self.mesh;
+        let k = self.channels.len();
         let mut h = [0.0f64; 3];
         let mut ch = vec![[0.0f64; 3]; k];
         let mut var = 0.0;
@@ -275,10 +395,10 @@ impl<I: Intersector> Ctx<'_, I> {
         if n_direct > 0 {
             let mut m = Vec::with_capacity(n_direct);
             let mut sum = [0.0f64; 3];
-            let here = latin(n_direct, false, &mut rng);
-            let there = latin(n_direct, true, &mut rng);
+            let here = latin(n_direct, false, rng);
+            let there = latin(n_direct, true, rng);
             for (&(u, v), &(s, t)) in here.iter().zip(&there) {
-                let x = points.at(u, v) + n * eps;
+                let x = at(u, v) + n * eps;
                 // Stratified choice of the emitter, then a point on it from the rest of `s`.
                 let (e, w, s2) = self.pick_emitter(f64::from(s));
                 let j = self.emitters[e];
@@ -314,10 +434,10 @@ impl<I: Intersector> Ctx<'_, I> {
         // The sun: directions over its disc, shadow rays to the sky.
         if let Some(sun) = sun {
             let (mut m, mut sum) = (Vec::with_capacity(n_sun), [0.0f64; 3]);
-            let here = latin(n_sun, false, &mut rng);
-            let there = latin(n_sun, true, &mut rng);
+            let here = latin(n_sun, false, rng);
+            let there = latin(n_sun, true, rng);
             for (&(u, v), &(s, t)) in here.iter().zip(&there) {
-                let x = points.at(u, v) + n * eps;
+                let x = at(u, v) + n * eps;
                 let val = self.sun_sample(i, sun, x, n, eps, f64::from(s), f64::from(t));
                 rays += 1;
                 m.push(scalar(&[0, 1, 2].map(|q| rho[q] * val[q])));
@@ -335,12 +455,12 @@ impl<I: Intersector> Ctx<'_, I> {
         let x_count = grid.len();
         let angle = rng.gen::<f32>() * std::f32::consts::TAU;
         let frame = Frame::new(n, angle);
-        let here = latin(x_count, false, &mut rng);
+        let here = latin(x_count, false, rng);
         let mut m = Vec::with_capacity(x_count);
         let mut sum = [0.0f64; 3];
         for (cell, &(u, v)) in here.iter().enumerate() {
-            let dir = frame.to_world(grid.direction(cell, 0.0, true, &mut rng));
-            let org = points.at(u, v) + n * eps;
+            let dir = frame.to_world(grid.direction(cell, 0.0, true, rng));
+            let org = at(u, v) + n * eps;
             let ray = Ray {
                 org,
                 dir,
@@ -371,7 +491,7 @@ impl<I: Intersector> Ctx<'_, I> {
                         emitted = self.e[r].map(|e| e * (1.0 - w));
                     }
                 }
-                sub = self.reflected_at(r, org + dir * t, t, 0, &mut rng);
+                sub = self.reflected_at(r, org + dir * t, t, 0, rng);
                 rays += sub.rays;
             }
             if hit.is_none() {
@@ -706,47 +826,14 @@ pub fn apply<I: Intersector>(
     let todo: Vec<usize> = (0..np)
         .filter(|&i| !faces_void(i) && scalar(&rho[i]) > 0.0)
         .collect();
-    // Emitters by scalar power; a back twin emits from the back of its surface.
-    let mut emitters = Vec::new();
-    let mut cdf = Vec::new();
-    let mut power = 0.0;
-    for (i, p) in mesh.patches.iter().enumerate() {
-        let w = scalar(&e[i]) * p.area;
-        if w > 0.0 {
-            power += w;
-            emitters.push(i);
-            cdf.push(power);
-        }
-    }
-    let reach = mesh
-        .vertices
-        .iter()
-        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
-    let ctx = Ctx {
-        mesh,
-        isect,
-        emitter_points: emitters
-            .iter()
-            .map(|&j| PatchPoints::new(mesh, j))
-            .collect(),
+    let inputs = Inputs {
         e: &e,
         rho: &rho,
         b: &sol.b,
         channels: &sol.channels,
         group: group.filter(|_| !sol.channels.is_empty()),
-        emitters,
-        cdf,
-        power,
-        eps_floor: reach * 5e-7,
-        seed,
-        rays: rays.max(4),
-        sky,
-        trans: if materials.iter().any(|m| m.transmittance > 0.0) {
-            (0..np).map(|i| mat(i).transmittance).collect()
-        } else {
-            Vec::new()
-        },
     };
+    let ctx = Ctx::new(mesh, materials, isect, inputs, seed, rays, sky);
     let gathered: Vec<Gathered> = todo.par_iter().map(|&i| ctx.gather(i)).collect();
 
     let mut sigma = shooting.parts.sigma.clone();

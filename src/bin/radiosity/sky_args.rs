@@ -43,6 +43,15 @@ pub struct SkyArgs {
     /// The model's north X,Y,Z (its horizontal part counts).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,-1")]
     pub north: Vec3,
+    /// Illuminance sensors: HEIGHT,SPACING in metres (a work plane above each floor: an
+    /// upward surface with at least 2.3 m clear above it), or a CSV file of points with
+    /// columns x,y,z,nx,ny,nz. Writes grid.csv (x,y,z,nx,ny,nz,lux,df), the plan grid.png,
+    /// and the grid's mean/min/uniformity in summary.json.
+    #[arg(long, value_name = "HEIGHT,SPACING|POINTS.csv")]
+    pub grid: Option<radiosity::grid::GridSpec>,
+    /// Rays each grid sensor gathers.
+    #[arg(long, default_value_t = radiosity::pipeline::daylight::DEFAULT_GRID_RAYS, value_name = "N")]
+    pub grid_rays: usize,
 }
 
 /// `--sky`.

@@ -84,6 +84,8 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
         checkpoint_every: a.checkpoint_every,
         resume: a.resume,
         interrupt: Some(interrupt_flag()),
+        grid: a.sky.grid.clone(),
+        grid_rays: a.sky.grid_rays,
     };
     let quiet = a.quiet || a.json;
     let progress = Progress::for_terminal(quiet);
