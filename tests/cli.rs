@@ -28,9 +28,10 @@ fn solve_default_scene_writes_the_three_outputs() {
     assert!(stdout.contains("patches"), "{stdout}");
     let csv = std::fs::read_to_string(out.join("patches.csv")).unwrap();
     let mut lines = csv.lines();
+    // The contract's 17 columns, then issue 14's lux and daylight factor.
     assert_eq!(
         lines.next().unwrap(),
-        "id,cx,cy,cz,nx,ny,nz,area,rho_r,rho_g,rho_b,e_r,e_g,e_b,b_r,b_g,b_b"
+        "id,cx,cy,cz,nx,ny,nz,area,rho_r,rho_g,rho_b,e_r,e_g,e_b,b_r,b_g,b_b,lux,df"
     );
     let rows: Vec<&str> = lines.collect();
     assert!(rows.len() > 100);

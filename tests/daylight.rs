@@ -120,3 +120,80 @@ fn glazing_passes_its_transmittance_and_the_books_close() {
     // The pane is two-sided: light from outside is not lost on its back.
     assert!(glazed.stats.energy.back_fraction() < 1e-9);
 }
+
+#[test]
+fn sky_flags_a_user_gets_wrong_are_one_line_and_exit_2() {
+    common::assert_user_error(
+        &["solve", "--sky", "clear", "--out", "/tmp/x"],
+        &["--sky", "sun"],
+    );
+    common::assert_user_error(
+        &["solve", "--sun", "30,20", "--out", "/tmp/x"],
+        &["--sun", "--sky"],
+    );
+    common::assert_user_error(
+        &[
+            "solve",
+            "--sky",
+            "overcast",
+            "--sun",
+            "2026-06-21T12:00+02:00",
+            "--out",
+            "/tmp/x",
+        ],
+        &["--site"],
+    );
+    common::assert_user_error(&["solve", "--grid", "0.8", "--out", "/tmp/x"], &["--grid"]);
+    common::assert_user_error(
+        &[
+            "solve", "--sky", "overcast", "--method", "hemicube", "--out", "/tmp/x",
+        ],
+        &["--sky"],
+    );
+}
+
+#[test]
+fn a_daylit_solve_writes_the_grid_and_the_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("room.obj");
+    // A 4 × 3 × 4 m room open at the top (no roof), the sky lighting its floor.
+    std::fs::write(
+        &obj,
+        "mtllib room.mtl\nusemtl wall\n\
+         v 0 0 0\nv 4 0 0\nv 4 0 4\nv 0 0 4\nv 0 3 0\nv 4 3 0\nv 4 3 4\nv 0 3 4\n\
+         f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path().join("room.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\n").unwrap();
+    let out = dir.path().join("o");
+    let grid = "0.8,1.0";
+    let (code, _, err) = common::run(&[
+        "solve",
+        obj.to_str().unwrap(),
+        "--sky",
+        "overcast",
+        "--grid",
+        grid,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let csv = std::fs::read_to_string(out.join("grid.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("x,y,z,nx,ny,nz,lux,df"));
+    let lux: Vec<f64> = lines
+        .map(|l| l.split(',').nth(6).unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(lux.len(), 16, "a 4 × 4 lattice at 1 m over the floor");
+    // Open above, walls 3 m high: less than the unobstructed 10,000 lux, far more than 0.
+    assert!(lux.iter().all(|l| *l > 1000.0 && *l < 10_000.0), "{lux:?}");
+    assert!(image::open(out.join("grid.png")).is_ok());
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["sky"]["kind"], "overcast");
+    assert!((s["sky"]["sky_illuminance"].as_f64().unwrap() - 10_000.0).abs() < 1e-6);
+    assert_eq!(s["grid"]["points"], 16);
+    let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
+    assert!(patches.lines().next().unwrap().ends_with(",lux,df"));
+    assert!(!patches.contains("NaN") && !csv.contains("NaN"));
+}
