@@ -61,7 +61,7 @@ pub struct Material {
     pub rho_source: RhoSource,
     /// Glazing (issue 14): the share of light that goes straight through, unchanged in
     /// direction (grey; 0 for opaque). ρ + transmittance ≤ 1; the rest is absorbed. Read from
-    /// the MTL by [`crate::scene::obj`]'s rule (`Tf`, `d`, `Tr`, `illum`).
+    /// the MTL by `scene::obj`'s rule (`Tf`, `d`, `Tr`, `illum`).
     pub transmittance: f64,
 }
 

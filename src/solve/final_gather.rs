@@ -130,7 +130,7 @@ struct Ctx<'a, I> {
 }
 
 /// A hemisphere ray meeting a side closer than this many times the side's size (√A) takes the
-/// light at the point it met, not the side's B ([`Ctx::reflected_at`]): a constant B over a
+/// light at the point it met, not the side's B (`Ctx::reflected_at`): a constant B over a
 /// patch is what the patch sends afar, not what its own parts send to something beside them.
 pub const NEAR: f32 = 1.0;
 
@@ -225,7 +225,7 @@ impl<'a, I: Intersector> Ctx<'a, I> {
 }
 
 /// Irradiance (RGB, W/m²) at sensors (point, facing direction) from the solved radiosity `b`
-/// (issue 14's grid): each sensor gathers as a patch does ([`Ctx::gather_at`]: light samples of
+/// (issue 14's grid): each sensor gathers as a patch does (`Ctx::gather_at`: light samples of
 /// the emitters and the sun, hemisphere rays that see the solution, the sky and through
 /// glazing, near hits followed), `rays` rays each; reproducible for `seed`.
 #[allow(clippy::too_many_arguments)]
