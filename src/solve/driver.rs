@@ -238,6 +238,13 @@ impl<'a, I: Intersector> Driver<'a, I> {
         if sky.is_some() && !method.casts_rays() {
             return Err(SolveError::SkyNeedsRays(method.name()));
         }
+        if sky.is_some() && hooks.light_groups.is_some() {
+            // The sky's and sun's light would be in no channel, and the channels would no
+            // longer sum to B (issue 14 item 4 is not built yet).
+            return Err(SolveError::Sky(
+                "--per-light does not yet keep the sky and the sun in channels of their own; solve without --per-light".into(),
+            ));
+        }
         let sky_lit = sky.as_ref().is_some_and(|s| {
             s.pieces()
                 .iter()
