@@ -32,6 +32,8 @@ pub struct MaterialInfo {
     /// object whose `kind` says which).
     pub rho_source: RhoSource,
     pub ke: [f64; 3],
+    /// Glazing's straight-through transmittance (0: opaque).
+    pub transmittance: f64,
     pub polygons: usize,
 }
 
@@ -127,6 +129,7 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
                 rho: m.rho,
                 rho_source: m.rho_source.clone(),
                 ke: m.ke,
+                transmittance: m.transmittance,
                 polygons,
             })
             .collect(),
@@ -164,6 +167,12 @@ impl std::fmt::Display for SceneInfo {
             "bounds         [{:.4}, {:.4}, {:.4}] .. [{:.4}, {:.4}, {:.4}] m (size {:.4} × {:.4} × {:.4})",
             lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]
         )?;
+        let (z, n) = (crate::sky::DEFAULT_ZENITH, crate::sky::DEFAULT_NORTH);
+        writeln!(
+            f,
+            "orientation    zenith {},{},{}  north {},{},{} (for --sky and --grid; change with --zenith, --north)",
+            z.x, z.y, z.z, n.x, n.y, n.z
+        )?;
         writeln!(f, "materials      {}", self.materials.len())?;
         for m in &self.materials {
             writeln!(
@@ -172,6 +181,13 @@ impl std::fmt::Display for SceneInfo {
                 m.name, m.rho[0], m.rho[1], m.rho[2], m.ke[0], m.ke[1], m.ke[2], m.polygons
             )?;
             writeln!(f, "  {:<20} rho from {}", "", m.rho_source)?;
+            if m.transmittance > 0.0 {
+                writeln!(
+                    f,
+                    "  {:<20} glazing: transmittance {:.3}",
+                    "", m.transmittance
+                )?;
+            }
         }
         writeln!(f, "lights         {}", self.lights.len())?;
         for l in &self.lights {
