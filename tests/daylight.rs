@@ -197,3 +197,37 @@ fn a_daylit_solve_writes_the_grid_and_the_sky() {
     assert!(patches.lines().next().unwrap().ends_with(",lux,df"));
     assert!(!patches.contains("NaN") && !csv.contains("NaN"));
 }
+
+#[test]
+fn per_light_channels_keep_the_sky_and_the_sun_apart_and_sum_to_b() {
+    use radiosity::solve::lights::{LightGroups, SKY_CHANNEL, SUN_CHANNEL};
+    let s = roofed(false);
+    let m = mesh_at(&s, Some(0.5));
+    let cfg = SolveSettings {
+        sky: Some(sky(SkyKind::Clear, Some((50.0, 20.0)))),
+        ..SolveSettings::default()
+    };
+    let hooks = radiosity::solve::RunHooks {
+        light_groups: Some(std::sync::Arc::new(LightGroups {
+            names: vec![SKY_CHANNEL.into(), SUN_CHANNEL.into()],
+            of_patch: vec![u32::MAX; m.patches.len()],
+        })),
+        ..Default::default()
+    };
+    let sol = common::solve_mesh_with(&s, &m, &cfg, &hooks);
+    assert_eq!(sol.channels.len(), 2);
+    let (mut sky_sum, mut sun_sum) = (0.0, 0.0);
+    for (j, b) in sol.b.iter().enumerate() {
+        for q in 0..3 {
+            let sum = sol.channels[0].b[j][q] + sol.channels[1].b[j][q];
+            assert!(
+                (sum - b[q]).abs() <= 1e-9 * b[q].max(1e-12),
+                "patch {j}: {sum} vs {}",
+                b[q]
+            );
+        }
+        sky_sum += sol.channels[0].b[j][1] * m.patches[j].area;
+        sun_sum += sol.channels[1].b[j][1] * m.patches[j].area;
+    }
+    assert!(sky_sum > 0.0 && sun_sum > 0.0, "{sky_sum} {sun_sum}");
+}

@@ -18,7 +18,14 @@ pub fn build(job: &SolveJob, model: &Model, log: &mut impl FnMut(&str)) -> Resul
         ..RunHooks::default()
     };
     if let Some(by) = job.settings.per_light {
-        let g = lights::groups(scene, m, by);
+        let mut g = lights::groups(scene, m, by);
+        // The sky (with the ground glow) and the sun get channels of their own (issue 14).
+        if let Some(spec) = &job.settings.solve.sky {
+            g.names.push(lights::SKY_CHANNEL.to_string());
+            if spec.sun.is_some() {
+                g.names.push(lights::SUN_CHANNEL.to_string());
+            }
+        }
         log(&format!(
             "per-light channels: {} ({})",
             g.len(),

@@ -238,13 +238,6 @@ impl<'a, I: Intersector> Driver<'a, I> {
         if sky.is_some() && !method.casts_rays() {
             return Err(SolveError::SkyNeedsRays(method.name()));
         }
-        if sky.is_some() && hooks.light_groups.is_some() {
-            // The sky's and sun's light would be in no channel, and the channels would no
-            // longer sum to B (issue 14 item 4 is not built yet).
-            return Err(SolveError::Sky(
-                "--per-light does not yet keep the sky and the sun in channels of their own; solve without --per-light".into(),
-            ));
-        }
         let sky_lit = sky.as_ref().is_some_and(|s| {
             s.pieces()
                 .iter()
@@ -336,6 +329,15 @@ impl<'a, I: Intersector> Driver<'a, I> {
     /// The sky's pieces and the sun shoot, before any patch ([`sky_shots`]).
     fn shoot_sky(&mut self) {
         if let (Some((sky, bounds)), Some(caster)) = (self.sky.take(), &self.caster) {
+            let channels = self
+                .hooks
+                .light_groups
+                .as_ref()
+                .map(|g| sky_shots::Channels {
+                    k: g.len(),
+                    sky: g.channel(super::lights::SKY_CHANNEL),
+                    sun: g.channel(super::lights::SUN_CHANNEL),
+                });
             let done = sky_shots::shoot(
                 &mut self.st,
                 caster,
@@ -343,6 +345,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
                 &bounds,
                 self.energy_per_ray,
                 self.cfg.seed,
+                channels,
             );
             self.stats.shots += done.shots;
         }

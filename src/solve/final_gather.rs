@@ -127,6 +127,9 @@ struct Ctx<'a, I> {
     sky: Option<&'a Sky>,
     /// Straight-through transmittance per patch (glazing); empty when nothing transmits.
     trans: Vec<f64>,
+    /// The sky's and the sun's per-light channels, when kept.
+    sky_channel: Option<usize>,
+    sun_channel: Option<usize>,
 }
 
 /// A hemisphere ray meeting a side closer than this many times the side's size (√A) takes the
@@ -139,6 +142,15 @@ pub const NEAR_DEPTH: u32 = 3;
 
 /// A shooting estimate this many combined σ from the gather's is biased, not noisy: kept out.
 pub const BIAS_Z: f64 = 4.0;
+
+/// Adds `w`·`v` to channel `c` of `ch`, when there is one.
+fn add_to(ch: &mut [[f64; 3]], c: Option<usize>, v: [f64; 3], w: f64) {
+    if let Some(x) = c.and_then(|c| ch.get_mut(c)) {
+        for q in 0..3 {
+            x[q] += w * v[q];
+        }
+    }
+}
 
 /// What a ray met ([`Ctx::cast`]): the first opaque hit, the transmittance of the glazing
 /// before it, and what the panes' sides it met reflect towards it.
@@ -196,6 +208,7 @@ impl<'a, I: Intersector> Ctx<'a, I> {
             .iter()
             .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
         let t = |p: &crate::mesh::Patch| materials[p.material as usize].transmittance;
+        let channel = |name: &str| inputs.channels.iter().position(|c| c.name == name);
         Ctx {
             mesh,
             isect,
@@ -220,6 +233,8 @@ impl<'a, I: Intersector> Ctx<'a, I> {
             } else {
                 Vec::new()
             },
+            sky_channel: channel(super::lights::SKY_CHANNEL),
+            sun_channel: channel(super::lights::SUN_CHANNEL),
         }
     }
 }
@@ -444,6 +459,7 @@ impl<I: Intersector> Ctx<'_, I> {
                 for q in 0..3 {
                     sum[q] += val[q];
                 }
+                add_to(&mut ch, self.sun_channel, val, 1.0 / n_sun as f64);
             }
             for q in 0..3 {
                 h[q] += sum[q] / n_sun as f64;
@@ -510,6 +526,9 @@ impl<I: Intersector> Ctx<'_, I> {
                         chc[q] += seen.through * (sub.ch[c][q] + lit) / x_count as f64;
                     }
                 }
+            } else if hit.is_none() {
+                let w = seen.through / x_count as f64;
+                add_to(&mut ch, self.sky_channel, sub.v, w);
             }
         }
         for q in 0..3 {
@@ -662,12 +681,14 @@ impl<I: Intersector> Ctx<'_, I> {
         for q in 0..3 {
             h[q] += seen.panes[q] + w * l[q];
         }
+        add_to(&mut ch, self.sky_channel, l, w);
         if let Some(sun) = self.sky.and_then(Sky::sun) {
             rays += 1;
             let l = self.sun_sample(r, sun, x, n, eps, rng.gen(), rng.gen());
             for q in 0..3 {
                 h[q] += l[q];
             }
+            add_to(&mut ch, self.sun_channel, l, 1.0);
         }
         if let Some((s, t2)) =
             hit.and_then(|h| Some((mesh.receiver(h.patch, h.back)? as usize, h.t)))

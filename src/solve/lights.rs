@@ -19,6 +19,11 @@ pub enum GroupBy {
     Connected,
 }
 
+/// The per-light channel of the sky and its ground glow (`--per-light` with `--sky`).
+pub const SKY_CHANNEL: &str = "(sky)";
+/// The per-light channel of the sun.
+pub const SUN_CHANNEL: &str = "(sun)";
+
 /// The light group of every patch.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightGroups {
@@ -30,6 +35,11 @@ pub struct LightGroups {
 impl LightGroups {
     pub fn len(&self) -> usize {
         self.names.len()
+    }
+
+    /// The channel of `name` (the sky's, the sun's), if there is one.
+    pub fn channel(&self, name: &str) -> Option<usize> {
+        self.names.iter().position(|n| n == name)
     }
 
     pub fn is_empty(&self) -> bool {

@@ -141,7 +141,15 @@ pub struct SkyShots {
     pub rays: u64,
 }
 
-/// Shoots every piece of `sky` into the books at energy per ray `c`.
+/// The per-light channels (`--per-light`): how many, and the sky's and the sun's.
+#[derive(Clone, Copy, Debug)]
+pub struct Channels {
+    pub k: usize,
+    pub sky: Option<usize>,
+    pub sun: Option<usize>,
+}
+
+/// Shoots every piece of `sky` into the books at energy per ray `c` (and into its channel).
 pub(super) fn shoot<I: Intersector>(
     st: &mut State,
     caster: &RayCaster<'_, I>,
@@ -149,6 +157,7 @@ pub(super) fn shoot<I: Intersector>(
     bounds: &Bounds,
     c: f64,
     seed: u64,
+    channels: Option<Channels>,
 ) -> SkyShots {
     let mut out = SkyShots::default();
     for (k, piece) in sky.pieces().iter().enumerate() {
@@ -159,6 +168,16 @@ pub(super) fn shoot<I: Intersector>(
         let grid = PolarGrid::for_samples(super::scalar(&phi) / c);
         let x = grid.len();
         let phi_ray = phi.map(|p| p / x as f64);
+        // The shot's flux per channel: all of it in the sky's or the sun's.
+        let shot_ch: Vec<[f64; 3]> = channels.map_or_else(Vec::new, |ch| {
+            let own = match piece.kind {
+                crate::sky::PieceKind::Sun => ch.sun,
+                _ => ch.sky,
+            };
+            (0..ch.k)
+                .map(|c| if Some(c) == own { phi } else { [0.0; 3] })
+                .collect()
+        });
         st.emit_distant(&phi);
         let chunks: Vec<usize> = (0..x.div_ceil(CHUNK)).collect();
         for batch in chunks.chunks(BATCH_CHUNKS) {
@@ -181,6 +200,9 @@ pub(super) fn shoot<I: Intersector>(
                     st.deposit_back_distant(&phi_ray);
                 } else {
                     st.deposit(code as usize, &phi_ray);
+                    if !shot_ch.is_empty() {
+                        st.deposit_channels(code as usize, &shot_ch, 1.0 / x as f64);
+                    }
                 }
             }
         }
