@@ -218,12 +218,11 @@ fn per_light_channels_keep_the_sky_and_the_sun_apart_and_sum_to_b() {
     assert_eq!(sol.channels.len(), 2);
     let (mut sky_sum, mut sun_sum) = (0.0, 0.0);
     for (j, b) in sol.b.iter().enumerate() {
-        for q in 0..3 {
+        for (q, bq) in b.iter().enumerate() {
             let sum = sol.channels[0].b[j][q] + sol.channels[1].b[j][q];
             assert!(
-                (sum - b[q]).abs() <= 1e-9 * b[q].max(1e-12),
-                "patch {j}: {sum} vs {}",
-                b[q]
+                (sum - bq).abs() <= 1e-9 * bq.max(1e-12),
+                "patch {j}: {sum} vs {bq}"
             );
         }
         sky_sum += sol.channels[0].b[j][1] * m.patches[j].area;
