@@ -189,7 +189,7 @@ impl SavedSolution {
     /// Irradiance per patch (W/m²), `None` where the material reflects nothing.
     pub fn irradiance(&self) -> Vec<Option<f64>> {
         let sol = self;
-        const LUMA: [f64; 3] = [0.2126, 0.7152, 0.0722];
+        use super::patches::LUMA;
         (0..sol.mesh.patches.len())
             .map(|i| {
                 let mat = &sol.meta.materials[sol.mesh.patches[i].material as usize];

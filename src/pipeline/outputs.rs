@@ -71,16 +71,16 @@ pub fn write(
         written.push(path);
     };
     let csv = job.out.join("patches.csv");
-    let sky_lux = job
+    let sky = job
         .settings
         .solve
         .sky
         .as_ref()
-        .and_then(|s| crate::sky::Sky::new(s).ok())
-        .map(|s| {
-            let (sky, sun) = s.horizontal_illuminance();
-            sky + sun
-        });
+        .and_then(|s| crate::sky::Sky::new(s).ok());
+    let sky_lux = sky.as_ref().map(|s| {
+        let (sky, sun) = s.horizontal_illuminance();
+        sky + sun
+    });
     write_atomic(&csv, |w| {
         patches::write(w, m, &scene.materials, &sol.b, sky_lux)
     })?;
@@ -89,7 +89,7 @@ pub fn write(
     let grid = match &job.grid {
         Some(spec) => {
             let tg = Instant::now();
-            let g = measure_grid(job, run, spec)?;
+            let g = measure_grid(job, run, spec, sky.as_ref())?;
             grid_seconds = tg.elapsed().as_secs_f64();
             let grid_csv = job.out.join("grid.csv");
             crate::grid::write_csv(&grid_csv, &g.sensors, &g.lux, &g.df).map_err(|source| {
@@ -155,10 +155,13 @@ pub fn write(
     timings.total = run.t0.elapsed().as_secs_f64();
     let mut summary = summary(job, run, timings, energy, warnings, outputs);
     summary.grid = grid;
-    summary.sky = job.settings.solve.sky.as_ref().and_then(|spec| {
-        let sky = crate::sky::Sky::new(spec).ok()?;
-        Some(super::daylight::SkyReport::new(spec, &sky))
-    });
+    summary.sky = job
+        .settings
+        .solve
+        .sky
+        .as_ref()
+        .zip(sky.as_ref())
+        .map(|(spec, sky)| super::daylight::SkyReport::new(spec, sky));
     write_atomic(&json, |w| {
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
         writeln!(w)
@@ -256,25 +259,20 @@ fn measure_grid(
     job: &SolveJob,
     run: &Run,
     spec: &crate::grid::GridSpec,
+    sky: Option<&crate::sky::Sky>,
 ) -> Result<super::daylight::GridResult, Error> {
     let Some((isect, _)) = run.isect else {
         return Err(Error::Invalid(
             "--grid needs a method that casts rays (adaptive-hybrid or adaptive-rays)".into(),
         ));
     };
-    let sky = job
-        .settings
-        .solve
-        .sky
-        .as_ref()
-        .and_then(|s| crate::sky::Sky::new(s).ok());
     super::daylight::measure(
         spec,
         &run.model.mesh,
         &run.model.scene.materials,
         isect,
         &run.sol.b,
-        sky.as_ref(),
+        sky,
         &frame_of(job),
         job.grid_rays,
         job.settings.solve.seed,

@@ -418,7 +418,7 @@ pub fn parse_sizes(s: &str) -> Result<Sizes, String> {
         .map(Sizes)
 }
 
-fn parse_floats<const N: usize>(s: &str) -> Result<[f64; N], String> {
+pub fn parse_floats<const N: usize>(s: &str) -> Result<[f64; N], String> {
     let parts: Vec<&str> = s.split(',').collect();
     if parts.len() != N {
         return Err(format!("expected {N} comma-separated numbers, got '{s}'"));
@@ -446,7 +446,7 @@ pub fn parse_threads(s: &str) -> Result<usize, String> {
     }
 }
 
-fn parse_vec3(s: &str) -> Result<Vec3, String> {
+pub fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let v = parse_floats::<3>(s)?;
     Ok(Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32))
 }

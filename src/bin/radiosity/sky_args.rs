@@ -2,6 +2,7 @@
 //! north. Parsed here; checked by the library ([`radiosity::sky::Sky::new`]), so a bad value
 //! is one line naming the flag and a non-zero exit.
 
+use crate::args::{parse_floats, parse_vec3};
 use clap::Args;
 use glam::Vec3;
 use radiosity::sky::{
@@ -83,27 +84,7 @@ fn parse_sun(s: &str) -> Result<SunArg, String> {
 }
 
 fn parse_pair(s: &str) -> Result<(f64, f64), String> {
-    let v: Vec<f64> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("expected two numbers A,B; got '{s}'"))?;
-    match v[..] {
-        [a, b] if a.is_finite() && b.is_finite() => Ok((a, b)),
-        _ => Err(format!("expected two finite numbers A,B; got '{s}'")),
-    }
-}
-
-fn parse_vec3(s: &str) -> Result<Vec3, String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|_| format!("expected X,Y,Z; got '{s}'"))?;
-    match v[..] {
-        [x, y, z] => Ok(Vec3::new(x, y, z)),
-        _ => Err(format!("expected three numbers X,Y,Z; got '{s}'")),
-    }
+    parse_floats::<2>(s).map(|[a, b]| (a, b))
 }
 
 impl SkyArgs {
