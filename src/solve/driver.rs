@@ -100,6 +100,7 @@ pub fn shoot_with<I: Intersector>(
         let est = d.scalars.estimator(d.energy_per_ray);
         d.st.estimate_parts(&est)
     });
+    let sky = d.sky.take().map(|(s, _)| s);
     let mut sol = d.finish(reason, start);
     if let Some(parts) = keep {
         sol.shooting = Some(Box::new(super::ShotResult {
@@ -117,7 +118,7 @@ pub fn shoot_with<I: Intersector>(
             cfg.gather_rays_per_patch(),
             hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
             &shooting,
-            cfg.sky.as_ref().and_then(|s| Sky::new(s).ok()).as_ref(),
+            sky.as_ref(),
             hooks.reference.as_deref().map(Vec::as_slice),
             &mut sol,
             &mut on_trace,
@@ -195,7 +196,7 @@ struct Driver<'a, I> {
     scalars: PatchScalars,
     /// Casts the rays (the methods that cast rays).
     caster: Option<RayCaster<'a, I>>,
-    /// The sky and sun (issue 14) and the sphere they shoot at, until they have shot.
+    /// The sky and sun (issue 14) and the sphere they shoot at.
     sky: Option<(Sky, sky_shots::Bounds)>,
     /// Hemi-cube shots still to come (the hemi-cube methods, or the hybrid before it switches).
     cubes: Option<CubeShooter>,
@@ -328,7 +329,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
 
     /// The sky's pieces and the sun shoot, before any patch ([`sky_shots`]).
     fn shoot_sky(&mut self) {
-        if let (Some((sky, bounds)), Some(caster)) = (self.sky.take(), &self.caster) {
+        if let (Some((sky, bounds)), Some(caster)) = (&self.sky, &self.caster) {
             let channels = self
                 .hooks
                 .light_groups
@@ -341,8 +342,8 @@ impl<'a, I: Intersector> Driver<'a, I> {
             let done = sky_shots::shoot(
                 &mut self.st,
                 caster,
-                &sky,
-                &bounds,
+                sky,
+                bounds,
                 self.energy_per_ray,
                 self.cfg.seed,
                 channels,
