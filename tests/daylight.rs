@@ -230,3 +230,68 @@ fn per_light_channels_keep_the_sky_and_the_sun_apart_and_sum_to_b() {
     }
     assert!(sky_sum > 0.0 && sun_sum > 0.0, "{sky_sum} {sun_sum}");
 }
+
+/// From the command line: a daylit `solve --per-light --save` keeps `(sky)` and `(sun)` in the
+/// saved file, their channels sum to B there too, and `relight` rescales them without solving
+/// again: the sun off leaves the sky's picture, both off a black one.
+#[test]
+fn relight_a_day_from_the_saved_sky_and_sun_channels() {
+    use radiosity::export::solution::SavedSolution;
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).display().to_string();
+    std::fs::write(
+        p("room.obj"),
+        "mtllib room.mtl\nusemtl wall\n\
+         v 0 0 0\nv 4 0 0\nv 4 0 4\nv 0 0 4\nv 0 3 0\nv 4 3 0\nv 4 3 4\nv 0 3 4\n\
+         f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    std::fs::write(p("room.mtl"), "newmtl wall\nKd 0.5 0.5 0.5\n").unwrap();
+    let (code, _, err) = common::run(&[
+        "solve",
+        &p("room.obj"),
+        "--sky",
+        "clear",
+        "--sun",
+        "50,20",
+        "--per-light",
+        "--save",
+        &p("s.rad"),
+        "--out",
+        &p("o"),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let saved = SavedSolution::load(std::path::Path::new(&p("s.rad"))).unwrap();
+    let names: Vec<&str> = saved.channels.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, ["(sky)", "(sun)"]);
+    for (j, b) in saved.b.iter().enumerate() {
+        for q in 0..3 {
+            let sum = saved.channels[0].b[j][q] + saved.channels[1].b[j][q];
+            assert!((sum - b[q]).abs() <= 1e-9 * b[q].max(1e-12), "patch {j}");
+        }
+    }
+    // Mean pixel of a relit picture (linear .exr: what relight's weights scale).
+    let mean = |weights: &[&str], name: &str| {
+        let mut args = vec!["relight".to_string(), p("s.rad")];
+        for w in weights {
+            args.extend(["--weight".to_string(), w.to_string()]);
+        }
+        args.extend(["--out".to_string(), p(name)]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let (code, _, err) = common::run(&args);
+        assert_eq!(code, 0, "{err}");
+        let img = image::open(p(name)).unwrap().to_rgb32f();
+        img.pixels().map(|px| f64::from(px[1])).sum::<f64>() / img.pixels().len() as f64
+    };
+    let day = mean(&[], "day.exr");
+    let sky_only = mean(&["(sun)=0"], "sky.exr");
+    let dark = mean(&["(sun)=0", "(sky)=0"], "dark.exr");
+    let doubled = mean(&["(sun)=2", "(sky)=2"], "doubled.exr");
+    assert!(
+        day > 0.0 && sky_only > 0.0 && sky_only < day,
+        "{day} {sky_only}"
+    );
+    assert_eq!(dark, 0.0);
+    assert!((doubled / day - 2.0).abs() < 1e-4, "{doubled} / {day}");
+}

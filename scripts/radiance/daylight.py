@@ -380,7 +380,7 @@ class Radiance:
         lw = args.lw if args.lw is not None else 0.5 / args.ad
         self.opts = ["-h", "-I+", "-n", str(args.procs), "-ab", str(args.ab), "-ad", str(args.ad),
                      "-as", str(args.as_), "-aa", str(args.aa), "-lr", str(args.lr), "-lw",
-                     f"{lw:.3g}", "-dt", "0", "-dc", "1", "-ds", "0.02", "-dj", "0", "-dr", "0",
+                     f"{lw:.3g}", "-dt", "0", "-dc", "1", "-ds", "0.02", "-dj", f"{args.dj:g}", "-dr", "0",
                      "-u+"]
         if args.ar is not None:
             self.opts[-1:-1] = ["-ar", str(args.ar)]
@@ -685,6 +685,10 @@ def parse_args(argv=None):
     r.add_argument("--lr", type=int, default=-12, help="-lr (default -12)")
     r.add_argument("--lw", type=float, help="-lw (default 0.5 / ad, so first-bounce rays are "
                    "not cut short)")
+    r.add_argument("--dj", type=float, default=1.0,
+                   help="-dj (default 1: shadow rays sample the whole solar disc, as the tool "
+                   "does; -dj 0 takes the sun as a point, so a row of sensors on a penumbra is "
+                   "fully lit or fully shadowed where the disc is partly hidden)")
     r.add_argument("--procs", type=int, default=os.cpu_count() or 1, help="rtrace -n")
     ap.add_argument("--reference", type=Path, metavar="CSV",
                     help="also compare this Radiance run (e.g. cheaper settings) with another's "
