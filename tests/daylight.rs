@@ -193,6 +193,18 @@ fn a_daylit_solve_writes_the_grid_and_the_sky() {
     assert_eq!(s["sky"]["kind"], "overcast");
     assert!((s["sky"]["sky_illuminance"].as_f64().unwrap() - 10_000.0).abs() < 1e-6);
     assert_eq!(s["grid"]["points"], 16);
+    // CPU seconds beside the wall's: the solve and the grid did work, within the process's.
+    let cpu = |k: &str| s["cpu_seconds"][k].as_f64().unwrap();
+    assert!(
+        cpu("solve") > 0.0 && cpu("grid") > 0.0,
+        "{}",
+        s["cpu_seconds"]
+    );
+    assert!(
+        cpu("total") >= cpu("solve") + cpu("grid"),
+        "{}",
+        s["cpu_seconds"]
+    );
     let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
     assert!(patches.lines().next().unwrap().ends_with(",lux,df"));
     assert!(!patches.contains("NaN") && !csv.contains("NaN"));
@@ -266,9 +278,9 @@ fn relight_a_day_from_the_saved_sky_and_sun_channels() {
     let names: Vec<&str> = saved.channels.iter().map(|c| c.name.as_str()).collect();
     assert_eq!(names, ["(sky)", "(sun)"]);
     for (j, b) in saved.b.iter().enumerate() {
-        for q in 0..3 {
+        for (q, bq) in b.iter().enumerate() {
             let sum = saved.channels[0].b[j][q] + saved.channels[1].b[j][q];
-            assert!((sum - b[q]).abs() <= 1e-9 * b[q].max(1e-12), "patch {j}");
+            assert!((sum - bq).abs() <= 1e-9 * bq.max(1e-12), "patch {j}");
         }
     }
     // Mean pixel of a relit picture (linear .exr: what relight's weights scale).

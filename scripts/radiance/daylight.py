@@ -40,6 +40,7 @@ import json
 import math
 import os
 import re
+import resource
 import shlex
 import subprocess
 import sys
@@ -385,6 +386,8 @@ class Radiance:
         if args.ar is not None:
             self.opts[-1:-1] = ["-ar", str(args.ar)]
         self.run_seconds = []
+        self.run_cpu = []
+        self.last_cpu = 0.0
 
     def octree(self, model, sky: SkySettings, name="scene") -> Path:
         """The model (already in gensky's frame) and the sky, frozen (-f)."""
@@ -403,10 +406,11 @@ class Radiance:
     def _rtrace(self, opts, octree, origins, dirs):
         text = "".join(f"{o[0]:.9g} {o[1]:.9g} {o[2]:.9g} {d[0]:.9g} {d[1]:.9g} {d[2]:.9g}\n"
                        for o, d in zip(origins, dirs))
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), children_cpu()
         res = subprocess.run([self.bin / "rtrace", *opts, octree], input=text,
                              capture_output=True, text=True, env=self.env)
         seconds = time.perf_counter() - t0
+        self.last_cpu = children_cpu() - c0
         if res.returncode != 0:
             sys.exit(f"rtrace failed: {res.stderr}")
         return res.stdout, seconds
@@ -415,6 +419,7 @@ class Radiance:
         """RGB irradiance (W/m^2) at each origin on a surface facing dirs; one timed run."""
         out, seconds = self._rtrace(self.opts, octree, origins, dirs)
         self.run_seconds.append(seconds)
+        self.run_cpu.append(self.last_cpu)
         vals = np.array([[float(x) for x in line.split()[:3]]
                          for line in out.splitlines() if line.strip()])
         if len(vals) != len(origins):
@@ -428,6 +433,14 @@ class Radiance:
         if len(names) != len(origins):
             sys.exit(f"rtrace gave {len(names)} names for {len(origins)} rays")
         return names
+
+
+def children_cpu() -> float:
+    """CPU seconds (user + system) of this script's finished children: rtrace and the
+    processes it forks for -n. With the tool's own ``cpu_seconds`` these compare the work each
+    did, which a busy machine leaves as it is (wall seconds it does not)."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def radiance_lux(rad: Radiance, octree, pts_local, nrm_local, repeat: int, seed: int):
@@ -464,7 +477,7 @@ def match_accuracy(args, workdir, octree, pts_local, nrm_local, ref, target, one
         lux = radiance_lux(rad, octree, pts_local, nrm_local, 1, seed + 1000 + k)[0]
         err = float(np.abs(lux - ref).sum() / ref.sum())
         runs.append({"ad": ad, "area_averaged_error": err, "seconds": rad.run_seconds[0],
-                     "rtrace": " ".join(rad.opts)})
+                     "cpu_seconds": rad.run_cpu[0], "rtrace": " ".join(rad.opts)})
         if abs(err / target - 1) < 0.15:
             break
         if len(runs) >= 2:
@@ -476,7 +489,8 @@ def match_accuracy(args, workdir, octree, pts_local, nrm_local, ref, target, one
     best = min(runs, key=lambda r: abs(math.log(r["area_averaged_error"] / target)))
     ad_at = best["ad"] * (target / best["area_averaged_error"]) ** (1 / slope)
     return {"runs": runs, "slope": slope, "ad_at_tool_accuracy": ad_at,
-            "seconds_at_tool_accuracy": best["seconds"] * ad_at / best["ad"]}
+            "seconds_at_tool_accuracy": best["seconds"] * ad_at / best["ad"],
+            "cpu_seconds_at_tool_accuracy": best["cpu_seconds"] * ad_at / best["ad"]}
 
 
 # --------------------------------------------------------------------------------------------
@@ -570,6 +584,21 @@ def speed(tool_seconds: dict, rad: dict, fig: dict, matched: dict | None) -> dic
     if out["radiance_seconds_at_tool_accuracy"] is not None and t_tool > 0:
         out["speed_ratio_at_tool_accuracy"] = out["radiance_seconds_at_tool_accuracy"] / t_tool
         out["speed_meets"] = out["speed_ratio_at_tool_accuracy"] >= BARS["speed"]
+    # The same in CPU seconds (both sides' processes, all threads): what a busy machine leaves
+    # alone. Judged on these when both are known.
+    c_tool = (tool_seconds.get("cpu_solve") or 0.0) + (tool_seconds.get("cpu_grid") or 0.0)
+    c_rad = rad.get("cpu_seconds_one_run")
+    out["tool_cpu_seconds"] = c_tool or None
+    out["radiance_cpu_seconds_one_run"] = c_rad
+    c_at = None
+    if matched is not None and "cpu_seconds_at_tool_accuracy" in matched:
+        c_at = matched["cpu_seconds_at_tool_accuracy"]
+    elif c_rad is not None and math.isfinite(c_rad) and out["radiance_seconds_at_tool_accuracy"]:
+        c_at = c_rad * out["radiance_seconds_at_tool_accuracy"] / t_rad
+    out["radiance_cpu_seconds_at_tool_accuracy"] = c_at
+    out["cpu_ratio_at_tool_accuracy"] = c_at / c_tool if c_at and c_tool > 0 else None
+    if out["cpu_ratio_at_tool_accuracy"] is not None:
+        out["speed_meets"] = out["cpu_ratio_at_tool_accuracy"] >= BARS["speed"]
     return out
 
 
@@ -613,6 +642,9 @@ def tool_seconds(summary) -> dict:
     """The tool's times from its summary: solve, and the grid's gather if it reports one."""
     sec = summary.get("seconds", {})
     out = {"solve": sec.get("solve"), "total": sec.get("total")}
+    cpu = summary.get("cpu_seconds") or {}
+    if cpu:
+        out["cpu_solve"], out["cpu_grid"] = cpu.get("solve"), cpu.get("grid")
     for k in ("grid", "gather_grid", "sensors"):
         if k in sec:
             out["grid"] = sec[k]
@@ -793,12 +825,14 @@ def main(argv=None):
             cached = None
     if cached is None:
         runs = radiance_lux(rad, octree, pts_local, nrm_local, args.repeat, args.seed)
-        cached = {"key": key, "runs": runs.tolist(), "run_seconds": rad.run_seconds}
+        cached = {"key": key, "runs": runs.tolist(), "run_seconds": rad.run_seconds,
+                  "run_cpu": rad.run_cpu}
         saved.write_text(json.dumps(cached))
     else:
         print(f"Radiance's result reused from {saved} (--reuse)")
     runs = np.array(cached["runs"])
     run_seconds = cached["run_seconds"]
+    run_cpu = cached.get("run_cpu") or [float("nan")]
     ref = runs.mean(axis=0)
     write_grid_csv(out / "radiance-grid.csv", pts, nrm, runs, sky.sky_illuminance)
 
@@ -820,6 +854,7 @@ def main(argv=None):
                      "sky_rad": (out / "sky.rad").read_text(), "repeat": args.repeat,
                      "run_seconds": run_seconds,
                      "seconds_one_run": float(np.mean(run_seconds)),
+                     "cpu_seconds_one_run": float(np.mean(run_cpu)),
                      "noise": noise(runs),
                      "grid": stats(ref, 100 * ref / sky.sky_illuminance)},
         "bars": BARS,
@@ -912,6 +947,11 @@ def print_table(r, out):
               if f["speed_ratio_at_tool_accuracy"] else "-")
         print(f"  tool solve {t['solve']} s (grid {t.get('grid', '-')} s); Radiance one run / "
               f"tool = {ratio}; Radiance at the tool's accuracy: {eq}")
+        if f.get("cpu_ratio_at_tool_accuracy"):
+            print(f"  CPU seconds: tool {f['tool_cpu_seconds']:.3f} s, Radiance one run "
+                  f"{f['radiance_cpu_seconds_one_run']:.2f} s, at the tool's accuracy "
+                  f"{f['radiance_cpu_seconds_at_tool_accuracy']:.2f} s: "
+                  f"{f['cpu_ratio_at_tool_accuracy']:.1f}x")
         for m in rad.get("matched", {}).get("runs", []):
             print(f"    Radiance -ad {m['ad']}: {100 * m['area_averaged_error']:.2f} % "
                   f"area-averaged against the reference, {m['seconds']:.2f} s")
@@ -943,10 +983,13 @@ def print_markdown(paths):
             tcell = f"{tg['mean_lux']:.0f} / {tg['min_lux']:.0f}, {tg['uniformity']:.2f}"
             cells = [tcell, f"{100 * f['area_averaged_relative_error']:.2f} %",
                      f"{100 * f['median_point_relative_error']:.2f} %", noise_s,
-                     f"{f['tool_seconds']:.2f} s",
+                     f"{f['tool_seconds']:.2f} s" + (f" ({f['tool_cpu_seconds']:.2f} s CPU)"
+                                                     if f.get("tool_cpu_seconds") else ""),
                      f"{r['radiance']['seconds_one_run']:.1f} s",
-                     f"{f['speed_ratio_at_tool_accuracy']:.1f}x"
-                     if f["speed_ratio_at_tool_accuracy"] else "-"]
+                     (f"{f['speed_ratio_at_tool_accuracy']:.1f}x"
+                      if f["speed_ratio_at_tool_accuracy"] else "-")
+                     + (f" (CPU {f['cpu_ratio_at_tool_accuracy']:.1f}x)"
+                        if f.get("cpu_ratio_at_tool_accuracy") else "")]
         else:
             cells = ["-", "-", "-", noise_s, "-", f"{r['radiance']['seconds_one_run']:.1f} s",
                      "-"]

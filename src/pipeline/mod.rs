@@ -202,7 +202,7 @@ fn solve_into(
     }
 
     let hooks = hooks::build(job, &model, log)?;
-    let t = Instant::now();
+    let (t, c) = (Instant::now(), crate::report::process_cpu_seconds());
     progress.start_solve(outputs::emitted_flux(&model));
     let sol = model.solve(
         isect.as_ref().map(|(i, _)| i),
@@ -211,6 +211,7 @@ fn solve_into(
         |p: &TracePoint| progress.solve_wave(p),
     )?;
     timings.solve = t.elapsed().as_secs_f64();
+    timings.cpu.solve = crate::report::process_cpu_seconds() - c;
     log(&format!("solved: {}", Summary::stats_line(&sol.stats)));
 
     progress.phase("writing outputs");

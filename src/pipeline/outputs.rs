@@ -85,12 +85,13 @@ pub fn write(
         patches::write(w, m, &scene.materials, &sol.b, sky_lux)
     })?;
     wrote(csv);
-    let mut grid_seconds = 0.0;
+    let (mut grid_seconds, mut grid_cpu) = (0.0, 0.0);
     let grid = match &job.grid {
         Some(spec) => {
-            let tg = Instant::now();
+            let (tg, cg) = (Instant::now(), report::process_cpu_seconds());
             let g = measure_grid(job, run, spec, sky.as_ref())?;
             grid_seconds = tg.elapsed().as_secs_f64();
+            grid_cpu = report::process_cpu_seconds() - cg;
             let grid_csv = job.out.join("grid.csv");
             crate::grid::write_csv(&grid_csv, &g.sensors, &g.lux, &g.df).map_err(|source| {
                 crate::export::WriteError {
@@ -153,6 +154,8 @@ pub fn write(
     timings.output = t.elapsed().as_secs_f64();
     timings.grid = grid_seconds;
     timings.total = run.t0.elapsed().as_secs_f64();
+    timings.cpu.grid = grid_cpu;
+    timings.cpu.total = report::process_cpu_seconds();
     let mut summary = summary(job, run, timings, energy, warnings, outputs);
     summary.grid = grid;
     summary.sky = job
@@ -215,6 +218,7 @@ fn summary(
         switch: sol.stats.switch,
         final_gather: sol.stats.final_gather,
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
+        cpu_seconds: timings.cpu,
         seconds: timings,
         energy,
         light_channels: sol.channels.iter().map(|c| c.name.clone()).collect(),

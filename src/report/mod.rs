@@ -227,6 +227,29 @@ pub struct Timings {
     /// Of `output`: measuring the sensor grid (`--grid`).
     pub grid: f64,
     pub total: f64,
+    /// The same phases' CPU time (`summary.json`: `cpu_seconds`).
+    #[serde(skip)]
+    pub cpu: CpuSeconds,
+}
+
+/// Process CPU time (user + system, all threads) of the phases that do the work, seconds:
+/// beside the wall times of [`Timings`], figures that hold when other jobs share the cores
+/// (a wall time on a busy machine measures the machine; `scripts/radiance/daylight.py` sets
+/// the tool's CPU seconds against Radiance's beside the wall times).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct CpuSeconds {
+    pub solve: f64,
+    /// Measuring the sensor grid (`--grid`).
+    pub grid: f64,
+    pub total: f64,
+}
+
+/// CPU time this process has used so far (all threads, user + system), seconds; 0 where the
+/// platform does not tell.
+pub fn process_cpu_seconds() -> f64 {
+    cpu_time::ProcessTime::try_now()
+        .map(|t| t.as_duration().as_secs_f64())
+        .unwrap_or(0.0)
 }
 
 /// The energy balance with its residual (docs/design.md §1: emitted = absorbed + absorbed on back faces + escaped + unshot).
@@ -294,6 +317,7 @@ pub struct Summary {
     /// Rays cast per second of solve time.
     pub rays_per_second: f64,
     pub seconds: Timings,
+    pub cpu_seconds: CpuSeconds,
     pub energy: EnergyReport,
     /// Names of the per-light channels kept (`--per-light`), in channel order.
     pub light_channels: Vec<String>,
