@@ -307,3 +307,62 @@ fn relight_a_day_from_the_saved_sky_and_sun_channels() {
     assert_eq!(dark, 0.0);
     assert!((doubled / day - 2.0).abs() < 1e-4, "{doubled} / {day}");
 }
+
+/// `--zenith` decides which way is up for the work plane even without a sky (a Z-up model lit
+/// by its own lamp): the sensors stand 0.8 m off the wall that faces +Z, facing +Z.
+#[test]
+fn the_work_plane_follows_zenith_without_a_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).display().to_string();
+    std::fs::write(
+        p("room.obj"),
+        "mtllib room.mtl\n\
+         v 0 0 0\nv 4 0 0\nv 4 0 4\nv 0 0 4\nv 0 3 0\nv 4 3 0\nv 4 3 4\nv 0 3 4\n\
+         usemtl lamp\nf 1 4 3 2\nusemtl wall\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\nf 5 6 7 8\n",
+    )
+    .unwrap();
+    std::fs::write(
+        p("room.mtl"),
+        "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl lamp\nKd 0.5 0.5 0.5\nKe 1 1 1\n",
+    )
+    .unwrap();
+    let (code, _, err) = common::run(&[
+        "solve",
+        &p("room.obj"),
+        "--grid",
+        "0.8,1",
+        "--zenith",
+        "0,0,1",
+        "--north",
+        "0,1,0",
+        "--out",
+        &p("o"),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let csv = std::fs::read_to_string(dir.path().join("o/grid.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert!(!rows.is_empty());
+    for r in &rows {
+        assert!((r[2] - 0.8).abs() < 1e-4 && r[5] == 1.0, "{r:?}");
+        assert!(r[6] > 0.0, "{r:?}");
+    }
+    // A zenith that is no direction is refused before any work.
+    let (code, _, err) = common::run(&[
+        "solve",
+        &p("room.obj"),
+        "--grid",
+        "0.8,1",
+        "--zenith",
+        "0,0,0",
+        "--out",
+        &p("o2"),
+        "--quiet",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--zenith"), "{err}");
+}

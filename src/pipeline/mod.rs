@@ -104,6 +104,10 @@ pub struct SolveJob {
     pub grid: Option<crate::grid::GridSpec>,
     /// Rays each sensor gathers (`--grid-rays`).
     pub grid_rays: usize,
+    /// The model's up and north (`--zenith`, `--north`): the sky's frame, and the work plane's
+    /// up when a grid is asked for without a sky.
+    pub zenith: glam::Vec3,
+    pub north: glam::Vec3,
 }
 
 /// Seconds between checkpoints by default (`--checkpoint-every`).
@@ -125,6 +129,8 @@ impl SolveJob {
             interrupt: None,
             grid: None,
             grid_rays: daylight::DEFAULT_GRID_RAYS,
+            zenith: crate::sky::DEFAULT_ZENITH,
+            north: crate::sky::DEFAULT_NORTH,
         }
     }
 
@@ -144,6 +150,10 @@ impl SolveJob {
                 "--checkpoint-every must be a positive number of seconds, got {}",
                 self.checkpoint_every
             ));
+        }
+        if self.grid.is_some() {
+            crate::sky::Frame::new(self.zenith, self.north)
+                .map_err(|e| Invalid(format!("--zenith/--north: {e}")))?;
         }
         Ok(())
     }

@@ -86,6 +86,8 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
         interrupt: Some(interrupt_flag()),
         grid: a.sky.grid.clone(),
         grid_rays: a.sky.grid_rays,
+        zenith: a.sky.zenith,
+        north: a.sky.north,
     };
     let quiet = a.quiet || a.json;
     let progress = Progress::for_terminal(quiet);
