@@ -29,14 +29,14 @@ pub struct RenderArgs {
 }
 
 impl RenderArgs {
-    fn job(&self) -> RenderJob {
-        RenderJob {
+    fn job(&self) -> Result<RenderJob, radiosity::Error> {
+        Ok(RenderJob {
             solution: self.solution.clone(),
             check: self.check.check(),
             out: self.out.clone(),
-            view: self.view.settings(),
+            view: self.view.settings()?,
             false_colour: self.false_colour,
-        }
+        })
     }
 }
 
@@ -71,14 +71,14 @@ pub struct RelightArgs {
 }
 
 pub fn render(a: RenderArgs) -> Result<(), radiosity::Error> {
-    let r = saved::run_render(&a.job())?;
+    let r = saved::run_render(&a.job()?)?;
     print_report(&r, a.json, a.quiet);
     Ok(())
 }
 
 pub fn relight(a: RelightArgs) -> Result<(), radiosity::Error> {
     let job = RelightJob {
-        render: a.render.job(),
+        render: a.render.job()?,
         weights: a.weights,
     };
     let r = saved::run_relight(&job)?;
