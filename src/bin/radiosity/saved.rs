@@ -10,7 +10,8 @@ use std::path::PathBuf;
 pub struct RenderArgs {
     /// The saved solution (`radiosity solve --save FILE.rad`).
     solution: PathBuf,
-    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiosity, W/m²).
+    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiance, W/sr/m²: the
+    /// radiosity over π, as Radiance's rpict writes).
     #[arg(long)]
     out: PathBuf,
     #[command(flatten)]
@@ -106,7 +107,7 @@ fn print_report(r: &OutputReport, json: bool, quiet: bool) {
         let extra = match (&r.scale, r.exposure) {
             (Some(s), _) => format!(", irradiance {}–{} W/m² on a log scale", s.lo, s.hi),
             (None, Some(e)) => format!(", exposure {e:.4}"),
-            (None, None) => ", linear radiosity in W/m²".to_string(),
+            (None, None) => ", radiance in W/sr/m² (radiosity/π)".to_string(),
         };
         outln!(
             "{}: {} of {} ({} patches, {} vertices){extra}",
