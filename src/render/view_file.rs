@@ -522,6 +522,29 @@ mod tests {
     }
 
     #[test]
+    fn rays_match_radiances_vwrays() {
+        // `vwrays -vf v.hdr -x 64 -y 32 -pa 0 -fa` (Radiance 6.0a), first ray (top-left
+        // pixel): origin 0.5 0.5 0.5, direction -0.663121 0.326298 -0.673647.
+        let cam = parse("-vtv -vp 0.5 0.5 0.5 -vd 0 0 -1 -vu 0 1 0 -vh 90 -vv 53.130102")
+            .unwrap()
+            .camera();
+        let (o, d) = cam.ray(0.5 / 64.0, 0.5 / 32.0);
+        assert_eq!(o, Vec3::splat(0.5));
+        assert!(
+            (d - Vec3::new(-0.663121, 0.326298, -0.673647)).length() < 1e-5,
+            "{d}"
+        );
+        // A shifted, lifted parallel view, 40 × 20: origin 0.31 0.65 0.5, direction 0 0 -1.
+        let cam =
+            parse("-vtl -vp 0.5 0.5 0.5 -vd 0 0 -1 -vu 0 1 0 -vh 0.8 -vv 0.4 -vs 0.25 -vl -0.1")
+                .unwrap()
+                .camera();
+        let (o, d) = cam.ray(0.5 / 40.0, 0.5 / 20.0);
+        assert!((o - Vec3::new(0.31, 0.65, 0.5)).length() < 1e-6, "{o}");
+        assert_eq!(d, Vec3::NEG_Z);
+    }
+
+    #[test]
     fn view_options_read_back_to_the_same_camera() {
         let v = parse("rvu -vtv -vp 2 1.5 3 -vd 0 0 -2 -vu 0 1 0 -vh 60 -vv 45 -vo 0.25 -va 9 -vs 0.1 -vl -0.2").unwrap();
         let cam = v.camera();
