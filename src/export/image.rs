@@ -109,7 +109,8 @@ pub fn write_hdr(w: &mut dyn Write, img: &LinearImage, cam: &Camera) -> io::Resu
 /// Below 1e-32 is black; beyond RGBE's range is clamped to its largest value.
 fn rgbe(c: [f32; 3]) -> [u8; 4] {
     let d = c[0].max(c[1]).max(c[2]);
-    if !(d > 1e-32) {
+    // The pixels are cleaned (finite, ≥ 0) before they get here.
+    if d <= 1e-32 {
         return [0; 4];
     }
     // d = m·2^e with m in [0.5, 1): the exponent from the bits (d is a normal f32 here).

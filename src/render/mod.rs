@@ -59,7 +59,8 @@ impl Default for RenderOptions {
     }
 }
 
-/// Linear radiosity image (W/m² per channel), row-major, width*height, background black.
+/// Linear radiosity image (W/m² per channel), row-major, width*height, background black (the
+/// `.hdr`/`.exr` writers of [`crate::export::image`] store it as radiance, B/π).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LinearImage {
     pub width: u32,

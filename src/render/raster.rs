@@ -21,7 +21,7 @@ pub(super) struct View {
     pub(super) fwd: Vec3,
     /// Parallel projection: image-plane coordinates are view-space x, y (not x/z, y/z).
     pub(super) parallel: bool,
-    /// Half the picture's size on the image plane ([`super::camera::Projection::half_extent`]).
+    /// Half the picture's size on the image plane ([`crate::render::Projection::half_extent`]).
     half: Vec2,
     /// The picture's shift and lift (fractions of its width and height).
     shift: Vec2,
