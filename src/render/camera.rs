@@ -200,7 +200,13 @@ impl Camera {
                 };
             }
         }
-        unreachable!("one of y, z, x is at least 55° from any unit vector")
+        // Not reached (one of y, z, x is at least 54° from any unit vector), but never panic.
+        Frame {
+            right: Vec3::X,
+            up: Vec3::Y,
+            fwd: Vec3::NEG_Z,
+            given_up: Vec3::Y,
+        }
     }
 
     /// The eye, finite (the origin if not).
