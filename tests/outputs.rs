@@ -41,6 +41,8 @@ usemtl glow\n\
 f 1 5 6 2\nf 4 3 7 8\nf 1 2 3 4\nf 5 8 7 6\nf 1 4 8 5\nf 2 6 7 3\n";
 const FURNACE_MTL: &str = "newmtl glow\nKd 0.5 0.5 0.5\nKe 1 1 1\n";
 const FURNACE_B: f32 = 2.0 * std::f32::consts::PI;
+/// What `.hdr` and `.exr` pixels hold: radiance L = B/π (W/sr/m²), as Radiance's `rpict`.
+const FURNACE_L: f32 = FURNACE_B / std::f32::consts::PI;
 
 fn furnace(dir: &Path) -> PathBuf {
     std::fs::write(dir.join("f.mtl"), FURNACE_MTL).unwrap();
@@ -197,12 +199,12 @@ fn a_uniformly_lit_closed_box_renders_flat_at_e_over_one_minus_rho() {
         // The mean over ~50 patches in view: sampling noise of 2 % per patch averages down
         // well below 2 %; RGBE adds < 1 %.
         assert!(
-            (mean / FURNACE_B - 1.0).abs() < 0.02,
-            "{ext}: mean {mean}, expected {FURNACE_B}"
+            (mean / FURNACE_L - 1.0).abs() < 0.02,
+            "{ext}: mean {mean}, expected {FURNACE_L}"
         );
         // Every pixel: a single patch's noise (tolerance 2 %, a few σ) plus RGBE rounding.
         for v in &px {
-            assert!((v / FURNACE_B - 1.0).abs() < 0.1, "{ext}: pixel {v}");
+            assert!((v / FURNACE_L - 1.0).abs() < 0.1, "{ext}: pixel {v}");
         }
     }
     // The same solution with the radiosity set exactly: the image is exactly flat.
@@ -218,7 +220,7 @@ fn a_uniformly_lit_closed_box_renders_flat_at_e_over_one_minus_rho() {
     let img = image::open(&out).unwrap().to_rgb32f();
     for p in img.pixels() {
         for v in p.0 {
-            assert!((v / FURNACE_B - 1.0).abs() < 1e-5, "pixel {v}");
+            assert!((v / FURNACE_L - 1.0).abs() < 1e-5, "pixel {v}");
         }
     }
     // Checked against its own scene, the solution is accepted.

@@ -3,9 +3,11 @@
 //!
 //! The paper shows its solutions the classic way: radiosity is averaged to the patch vertices
 //! and Gouraud-interpolated across each patch. [`render_linear`] does exactly that in software:
-//! perspective projection, near-plane (and guard-band) clipping in view space, back-face culling
-//! by each patch's front normal, a Z-buffer on 1/z, perspective-correct interpolation of the
-//! vertex colours, and s×s supersampling box-filtered down to the output size. [`tone_map`] turns
+//! perspective or parallel projection ([`Camera`], Radiance's view conventions; a view can be
+//! read from a Radiance view file by [`view_file`]), near-, far- and guard-band clipping in view
+//! space, back-face culling by each patch's front normal, a Z-buffer on 1/z (−z for a parallel
+//! view), perspective-correct interpolation of the vertex colours, and s×s supersampling
+//! box-filtered down to the output size. [`tone_map`] turns
 //! the linear W/m² image into 8-bit sRGB, by a given exposure or one picked from a high
 //! percentile of the image's luminance.
 //!
@@ -24,8 +26,9 @@ pub mod glyphs;
 mod raster;
 mod tone;
 pub mod view;
+pub mod view_file;
 
-pub use camera::Camera;
+pub use camera::{Camera, Frame, Projection};
 pub use tone::{auto_exposure, srgb_encode, tone_map};
 pub use view::{CameraSpec, ViewSettings};
 
@@ -56,7 +59,8 @@ impl Default for RenderOptions {
     }
 }
 
-/// Linear radiosity image (W/m² per channel), row-major, width*height, background black.
+/// Linear radiosity image (W/m² per channel), row-major, width*height, background black (the
+/// `.hdr`/`.exr` writers of [`crate::export::image`] store it as radiance, B/π).
 #[derive(Clone, Debug, PartialEq)]
 pub struct LinearImage {
     pub width: u32,
@@ -85,7 +89,14 @@ pub fn render_linear(
     }
     let s = opts.supersample.clamp(1, 16) as usize;
     let view = View::new(camera, width * s, height * s);
-    let planes = view.planes(near_plane(mesh));
+    // A perspective view divides by depth, so it keeps a near plane in front of the eye; a
+    // parallel one clips at the plane through the eye (Radiance's -vtl with -vo 0).
+    let near = if camera.projection.is_parallel() {
+        camera.near_distance()
+    } else {
+        camera.near_distance().max(near_plane(mesh))
+    };
+    let planes = view.planes(near, camera.far_distance());
     let tris = screen_triangles(mesh, vertex_rgb, &view, &planes);
     draw_bands(&tris, &mut pixels, width, height, s);
     LinearImage {
@@ -95,7 +106,7 @@ pub fn render_linear(
     }
 }
 
-/// The near plane's distance, relative to the size of the mesh's finite vertices: depth is
+/// The least near plane's distance of a perspective view, relative to the size of the mesh's finite vertices: depth is
 /// tested on 1/z, which keeps its relative precision at any distance, so a small near plane
 /// costs nothing.
 fn near_plane(mesh: &Mesh) -> f32 {
@@ -158,12 +169,7 @@ mod tests {
     /// image).
     fn head_on() -> Camera {
         let d = 1.0 / 20f32.to_radians().tan();
-        Camera {
-            eye: Vec3::new(0.0, 0.0, d),
-            target: Vec3::ZERO,
-            up: Vec3::Y,
-            fov_y_deg: 40.0,
-        }
+        Camera::perspective(Vec3::new(0.0, 0.0, d), Vec3::ZERO, Vec3::Y, 40.0, 1.0)
     }
 
     fn opts(w: u32, h: u32, s: u32) -> RenderOptions {
@@ -255,12 +261,7 @@ mod tests {
             ],
             [[c_near; 3], [c_near; 3], [c_far; 3], [c_far; 3]],
         )]);
-        let cam = Camera {
-            eye: Vec3::ZERO,
-            target: Vec3::NEG_Z,
-            up: Vec3::Y,
-            fov_y_deg: 40.0,
-        };
+        let cam = Camera::perspective(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 40.0, 1.0);
         (mesh, rgb, cam)
     }
 
@@ -304,7 +305,10 @@ mod tests {
     #[test]
     fn fitted_camera_sees_all_corners_of_a_unit_box() {
         let cam = Camera::fit(Vec3::ZERO, Vec3::ONE, 640.0 / 480.0);
-        assert!(cam.eye.z > 1.0 && cam.fov_y_deg == 40.0);
+        assert!(cam.eye.z > 1.0);
+        assert!(
+            matches!(cam.projection, Projection::Perspective { fov_y_deg, .. } if fov_y_deg == 40.0)
+        );
         let view = View::new(&cam, 640, 480);
         let mut widest: f32 = 0.0;
         for i in 0..8 {
@@ -395,7 +399,21 @@ mod tests {
             eye: Vec3::NAN,
             target: Vec3::NAN,
             up: Vec3::NAN,
-            fov_y_deg: f32::NAN,
+            projection: Projection::Perspective {
+                fov_x_deg: f32::NAN,
+                fov_y_deg: f32::NAN,
+            },
+            near: f32::NAN,
+            far: Some(f32::NAN),
+            shift: glam::Vec2::NAN,
+        };
+        render_linear(&mesh, &rgb, &nan, &o);
+        let nan = Camera {
+            projection: Projection::Parallel {
+                width: f32::NAN,
+                height: -1.0,
+            },
+            ..nan
         };
         render_linear(&mesh, &rgb, &nan, &o);
         // NaN colours count as 0, short colour lists and bad indices are tolerated.
@@ -442,15 +460,211 @@ mod tests {
         quads(&qs)
     }
 
+    /// Cameras of every kind: perspective and parallel, shifted and lifted, clipped, aimed
+    /// off the axes.
+    fn cameras() -> Vec<Camera> {
+        let base = Camera::perspective(
+            Vec3::new(1.0, -2.0, 3.0),
+            Vec3::new(4.0, 0.5, -1.0),
+            Vec3::new(0.1, 1.0, 0.2),
+            50.0,
+            1.6,
+        );
+        vec![
+            base,
+            Camera {
+                shift: glam::Vec2::new(0.3, -0.45),
+                near: 0.7,
+                ..base
+            },
+            Camera {
+                projection: Projection::Parallel {
+                    width: 6.0,
+                    height: 2.5,
+                },
+                ..base
+            },
+            Camera {
+                projection: Projection::Parallel {
+                    width: 6.0,
+                    height: 2.5,
+                },
+                shift: glam::Vec2::new(-0.2, 1.5),
+                near: 2.0,
+                ..base
+            },
+        ]
+    }
+
+    #[test]
+    fn camera_rays_and_the_rasterizer_projection_agree() {
+        let (w, h) = (320usize, 200usize);
+        for cam in cameras() {
+            let view = View::new(&cam, w, h);
+            for (u, v) in [
+                (0.5, 0.5),
+                (0.0, 0.0),
+                (1.0, 1.0),
+                (0.13, 0.87),
+                (0.91, 0.07),
+            ] {
+                let (o, d) = cam.ray(u, v);
+                assert!((d.length() - 1.0).abs() < 1e-5);
+                // The origin lies on the fore clipping plane.
+                let f = cam.frame();
+                assert!(
+                    ((o - cam.eye).dot(f.fwd) - cam.near).abs() < 1e-4,
+                    "{cam:?}"
+                );
+                for t in [0.5f32, 3.0, 40.0] {
+                    let p = o + t * d;
+                    let (uv, z) = cam.project(p).unwrap();
+                    assert!(
+                        (uv.x - u).abs() < 1e-4 && (uv.y - v).abs() < 1e-4,
+                        "{uv} vs {u},{v}"
+                    );
+                    assert!(z > 0.0);
+                    let [sx, sy] = view.to_screen(view.to_view(p));
+                    assert!(
+                        (sx / w as f32 - u).abs() < 1e-4 && (sy / h as f32 - v).abs() < 1e-4,
+                        "rasterizer {sx},{sy} vs ray {u},{v} for {cam:?}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_speck_on_a_pixels_ray_lights_that_pixel_only() {
+        let (w, h) = (40u32, 24u32);
+        for cam in cameras() {
+            for (col, row) in [(0u32, 0u32), (17, 9), (39, 23)] {
+                let (u, v) = ((col as f32 + 0.5) / w as f32, (row as f32 + 0.5) / h as f32);
+                let (o, d) = cam.ray(u, v);
+                // A speck square to the ray, far smaller than the pixel's footprint, facing
+                // the camera.
+                let p = o + 6.0 * d;
+                let f = cam.frame();
+                let r = 0.002;
+                let (a, b) = (f.right * r, f.up * r);
+                let (mesh, rgb) =
+                    quads(&[([p - a - b, p + a - b, p + a + b, p - a + b], [[1.0; 3]; 4])]);
+                let img = render_linear(&mesh, &rgb, &cam, &opts(w, h, 1));
+                for (k, px) in img.pixels.iter().enumerate() {
+                    let lit = k == (row * w + col) as usize;
+                    assert_eq!(px[0] > 0.5, lit, "pixel {k}, speck at {col},{row}, {cam:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn perspective_fills_exactly_its_angles_of_view() {
+        // -vh 90 -vv 53.13: tan 45° = 1, tan 26.57° = 0.5, so at distance 1 the view spans
+        // x in [-1, 1], y in [-0.5, 0.5], a 2:1 picture.
+        let fov_y = 2.0 * 0.5f32.atan().to_degrees();
+        let cam = Camera {
+            projection: Projection::Perspective {
+                fov_x_deg: 90.0,
+                fov_y_deg: fov_y,
+            },
+            ..Camera::perspective(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, Vec3::Y, 1.0, 1.0)
+        };
+        assert!((cam.projection.aspect() - 2.0).abs() < 1e-5);
+        let rect = |s: f32| {
+            [
+                Vec3::new(-s, -0.5 * s, 0.0),
+                Vec3::new(s, -0.5 * s, 0.0),
+                Vec3::new(s, 0.5 * s, 0.0),
+                Vec3::new(-s, 0.5 * s, 0.0),
+            ]
+        };
+        // Just bigger than the view: every pixel covered; just smaller: the border empty.
+        let (mesh, rgb) = quads(&[(rect(1.001), [[1.0; 3]; 4])]);
+        let img = render_linear(&mesh, &rgb, &cam, &opts(64, 32, 1));
+        assert!(img.pixels.iter().all(|p| p[0] > 0.99));
+        let (mesh, rgb) = quads(&[(rect(0.96), [[1.0; 3]; 4])]);
+        let img = render_linear(&mesh, &rgb, &cam, &opts(64, 32, 1));
+        for (k, p) in img.pixels.iter().enumerate() {
+            let (c, r) = (k % 64, k / 64);
+            let border = c == 0 || c == 63 || r == 0 || r == 31;
+            assert_eq!(p[0] > 0.5, !border, "pixel {c},{r}");
+        }
+    }
+
+    #[test]
+    fn parallel_view_draws_sizes_independent_of_distance() {
+        // A 4 × 2 parallel view from z = 5 down -z: the view spans x in [-2, 2], y in [-1, 1].
+        let cam = Camera {
+            projection: Projection::Parallel {
+                width: 4.0,
+                height: 2.0,
+            },
+            ..Camera::perspective(Vec3::new(0.0, 0.0, 5.0), Vec3::ZERO, Vec3::Y, 1.0, 1.0)
+        };
+        for z in [0.0, -100.0] {
+            // A quad x in [-1, 1] covers the middle half of the columns at any distance.
+            let (mesh, rgb) = quads(&[(z_quad(z, 1.0), [[1.0; 3]; 4])]);
+            let img = render_linear(&mesh, &rgb, &cam, &opts(64, 32, 1));
+            for (k, p) in img.pixels.iter().enumerate() {
+                let c = k % 64;
+                assert_eq!(p[0] > 0.5, (16..48).contains(&c), "z {z}: pixel {k}");
+            }
+        }
+        // Depth still decides: the nearer quad wins in either order; what is behind the eye's
+        // plane is not drawn.
+        let far = (z_quad(-3.0, 3.0), [[1.0, 0.0, 0.0]; 4]);
+        let near = (z_quad(1.0, 0.5), [[0.0, 1.0, 0.0]; 4]);
+        let behind = (z_quad(6.0, 0.2), [[0.0, 0.0, 1.0]; 4]);
+        for order in [[far, near, behind], [behind, near, far]] {
+            let (mesh, rgb) = quads(&order);
+            let img = render_linear(&mesh, &rgb, &cam, &opts(64, 32, 1));
+            assert_eq!(img.pixels[16 * 64 + 32], [0.0, 1.0, 0.0]);
+            assert_eq!(img.pixels[0], [1.0, 0.0, 0.0]);
+        }
+        // Back faces are culled by the view direction, not by the eye's position.
+        let (mesh, rgb) = quads(&[(z_quad(-3.0, 3.0), [[1.0; 3]; 4])]);
+        let back = Camera {
+            eye: Vec3::new(0.0, 0.0, -5.0),
+            target: Vec3::new(0.0, 0.0, -6.0),
+            ..cam
+        };
+        let img = render_linear(&mesh, &rgb, &back, &opts(16, 8, 1));
+        assert!(img.pixels.iter().all(|p| *p == [0.0; 3]));
+    }
+
+    #[test]
+    fn near_clipping_sees_past_the_wall_in_front_of_the_eye() {
+        // The eye 0.2 behind a wall's face (z = 0.1, facing it); the next room's far wall at
+        // z = -3, large enough to fill the view.
+        let wall = (z_quad(0.1, 50.0), [[1.0, 0.0, 0.0]; 4]);
+        let far_wall = (z_quad(-3.0, 50.0), [[0.0, 1.0, 0.0]; 4]);
+        let (mesh, rgb) = quads(&[wall, far_wall]);
+        let mut cam = Camera::perspective(Vec3::new(0.0, 0.0, 0.3), Vec3::ZERO, Vec3::Y, 60.0, 1.5);
+        let img = render_linear(&mesh, &rgb, &cam, &opts(30, 20, 2));
+        assert!(img.pixels.iter().all(|p| *p == [1.0, 0.0, 0.0]), "the wall");
+        cam.near = 0.25;
+        let img = render_linear(&mesh, &rgb, &cam, &opts(30, 20, 2));
+        assert!(
+            img.pixels.iter().all(|p| *p == [0.0, 1.0, 0.0]),
+            "past the wall"
+        );
+        // The aft plane: nothing beyond 2 is drawn.
+        cam.far = Some(2.0);
+        let img = render_linear(&mesh, &rgb, &cam, &opts(30, 20, 2));
+        assert!(img.pixels.iter().all(|p| *p == [0.0; 3]), "beyond -va");
+    }
+
     #[test]
     fn room_is_closed_seen_from_inside() {
         let (mesh, rgb) = room(8);
-        let cam = Camera {
-            eye: Vec3::new(2.0, 3.0, 4.0),
-            target: Vec3::new(9.0, 7.0, 1.0),
-            up: Vec3::Y,
-            fov_y_deg: 60.0,
-        };
+        let cam = Camera::perspective(
+            Vec3::new(2.0, 3.0, 4.0),
+            Vec3::new(9.0, 7.0, 1.0),
+            Vec3::Y,
+            60.0,
+            97.0 / 61.0,
+        );
         // Every sample hits a wall: no background (crack) pixel anywhere.
         let img = render_linear(&mesh, &rgb, &cam, &opts(97, 61, 3));
         assert!(
@@ -464,12 +678,13 @@ mod tests {
     fn time_100k_triangles() {
         let (mesh, rgb) = room(91);
         let tris = 2 * mesh.patches.len();
-        let inside = Camera {
-            eye: Vec3::new(2.0, 3.0, 4.0),
-            target: Vec3::new(9.0, 7.0, 1.0),
-            up: Vec3::Y,
-            fov_y_deg: 60.0,
-        };
+        let inside = Camera::perspective(
+            Vec3::new(2.0, 3.0, 4.0),
+            Vec3::new(9.0, 7.0, 1.0),
+            Vec3::Y,
+            60.0,
+            640.0 / 480.0,
+        );
         let outside = Camera::fit(Vec3::ZERO, Vec3::splat(10.0), 640.0 / 480.0);
         for (name, cam) in [("inside", inside), ("fitted", outside)] {
             let t = std::time::Instant::now();

@@ -1,10 +1,11 @@
-//! The CPU rasterizer: the view transform and projection, culling and near-plane (and
-//! guard-band) clipping in view space, fan triangulation, the band scheduler, and Z-buffered,
-//! perspective-correct, watertight rasterization of each triangle.
+//! The CPU rasterizer: the view transform and projection (perspective or parallel, with
+//! Radiance's shift and lift), culling and near-, far- and guard-band clipping in view space,
+//! fan triangulation, the band scheduler, and Z-buffered, perspective-correct, watertight
+//! rasterization of each triangle.
 
 use super::Camera;
 use crate::mesh::Mesh;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 /// Output rows per rayon task (times the supersampling factor in sample rows).
@@ -14,52 +15,33 @@ const GUARD: f32 = 1.01;
 
 /// The camera's view transform and projection onto a sample grid.
 pub(super) struct View {
-    eye: Vec3,
+    pub(super) eye: Vec3,
     right: Vec3,
     up: Vec3,
-    fwd: Vec3,
-    tan_x: f32,
-    tan_y: f32,
+    pub(super) fwd: Vec3,
+    /// Parallel projection: image-plane coordinates are view-space x, y (not x/z, y/z).
+    pub(super) parallel: bool,
+    /// Half the picture's size on the image plane ([`crate::render::Projection::half_extent`]).
+    half: Vec2,
+    /// The picture's shift and lift (fractions of its width and height).
+    shift: Vec2,
     width: f32,
     height: f32,
 }
 
 impl View {
-    /// Builds an orthonormal basis; a degenerate camera (eye == target, up parallel to the view
-    /// direction, non-finite values) falls back to looking along -z and to another up vector.
+    /// The camera's frame ([`Camera::frame`], degenerate cameras fall back) and projection on
+    /// a `width`×`height` sample grid.
     pub(super) fn new(camera: &Camera, width: usize, height: usize) -> View {
-        let eye = camera.eye;
-        let mut fwd = (camera.target - eye).normalize_or_zero();
-        if fwd == Vec3::ZERO {
-            fwd = Vec3::NEG_Z;
-        }
-        let mut right = Vec3::X;
-        for up in [camera.up, Vec3::Y, Vec3::Z, Vec3::X] {
-            let r = fwd.cross(up.normalize_or_zero());
-            // sin of the angle between fwd and up above 1e-3: the basis is well conditioned.
-            if r.is_finite() && r.length_squared() > 1e-6 {
-                right = r.normalize();
-                break;
-            }
-        }
-        let fov = if camera.fov_y_deg.is_finite() {
-            camera.fov_y_deg.clamp(0.01, 179.0)
-        } else {
-            40.0
-        };
-        let tan_y = (0.5 * fov).to_radians().tan();
-        let aspect = if height > 0 {
-            width as f32 / height as f32
-        } else {
-            1.0
-        };
+        let f = camera.frame();
         View {
-            eye,
-            right,
-            up: right.cross(fwd),
-            fwd,
-            tan_x: tan_y * aspect,
-            tan_y,
+            eye: camera.eye_or_origin(),
+            right: f.right,
+            up: f.up,
+            fwd: f.fwd,
+            parallel: camera.projection.is_parallel(),
+            half: camera.projection.half_extent(),
+            shift: camera.shift_or_zero(),
             width: width as f32,
             height: height as f32,
         }
@@ -71,24 +53,48 @@ impl View {
         Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.fwd))
     }
 
-    /// View space (z > 0) → sample-grid coordinates, y down, pixel centres at +0.5.
+    /// View space (z > 0 for a perspective view) → sample-grid coordinates, y down, pixel
+    /// centres at +0.5: [`Camera::project`]'s (u, v) times the grid's size.
     pub(super) fn to_screen(&self, v: Vec3) -> [f32; 2] {
+        let (px, py) = if self.parallel {
+            (v.x, v.y)
+        } else {
+            (v.x / v.z, v.y / v.z)
+        };
         [
-            (0.5 + 0.5 * v.x / (v.z * self.tan_x)) * self.width,
-            (0.5 - 0.5 * v.y / (v.z * self.tan_y)) * self.height,
+            (0.5 + 0.5 * px / self.half.x - self.shift.x) * self.width,
+            (0.5 - 0.5 * py / self.half.y + self.shift.y) * self.height,
         ]
     }
 
-    /// The five clip planes (n, d), inside where n·p + d ≥ 0: near, then the guard band.
-    pub(super) fn planes(&self, near: f32) -> [(Vec3, f32); 5] {
-        let (gx, gy) = (GUARD * self.tan_x, GUARD * self.tan_y);
-        [
-            (Vec3::Z, -near),
-            (Vec3::new(1.0, 0.0, gx), 0.0),
-            (Vec3::new(-1.0, 0.0, gx), 0.0),
-            (Vec3::new(0.0, 1.0, gy), 0.0),
-            (Vec3::new(0.0, -1.0, gy), 0.0),
-        ]
+    /// The clip planes (n, d), inside where n·p + d ≥ 0: near, the guard band (left, right,
+    /// bottom, top), then far if there is one.
+    pub(super) fn planes(&self, near: f32, far: Option<f32>) -> Vec<(Vec3, f32)> {
+        // The picture spans centre ± half on the image plane; the band GUARD times as wide.
+        let centre = 2.0 * self.half * self.shift;
+        let (lo, hi) = (centre - GUARD * self.half, centre + GUARD * self.half);
+        let mut planes = vec![(Vec3::Z, -near)];
+        if self.parallel {
+            // x ≥ lo.x: n = +x, d = −lo.x; and so on.
+            planes.extend([
+                (Vec3::X, -lo.x),
+                (Vec3::NEG_X, hi.x),
+                (Vec3::Y, -lo.y),
+                (Vec3::NEG_Y, hi.y),
+            ]);
+        } else {
+            // x/z ≥ lo.x ⇔ x − lo.x·z ≥ 0 (z > 0 past the near plane); and so on.
+            planes.extend([
+                (Vec3::new(1.0, 0.0, -lo.x), 0.0),
+                (Vec3::new(-1.0, 0.0, hi.x), 0.0),
+                (Vec3::new(0.0, 1.0, -lo.y), 0.0),
+                (Vec3::new(0.0, -1.0, hi.y), 0.0),
+            ]);
+        }
+        if let Some(far) = far {
+            planes.push((Vec3::NEG_Z, far));
+        }
+        planes
     }
 }
 
@@ -99,13 +105,16 @@ struct ClipVert {
     c: Vec3,
 }
 
-/// A projected triangle: sample-grid positions, 1/z and colour/z per vertex.
+/// A projected triangle: sample-grid positions, the perspective weight w (1/z; 1 for a
+/// parallel view, whose interpolation is affine on the screen), colour·w, and the depth key
+/// (larger is nearer: 1/z, or −z for a parallel view; both are affine on the screen).
 #[derive(Clone, Copy)]
 pub(super) struct ScreenTri {
     x: [f32; 3],
     y: [f32; 3],
     w: [f32; 3],
     cw: [Vec3; 3],
+    key: [f32; 3],
 }
 
 /// Culls, clips and projects every patch (in parallel, order kept so results are
@@ -173,7 +182,7 @@ pub(super) fn draw_bands(
             let rows = out.len() / width * s;
             let y0 = b * band_samples;
             let mut colour = vec![Vec3::ZERO; rows * ws];
-            let mut depth = vec![0.0f32; rows * ws];
+            let mut depth = vec![f32::NEG_INFINITY; rows * ws];
             for &i in bin {
                 rasterize(&tris[i as usize], y0, rows, ws, &mut colour, &mut depth);
             }
@@ -224,7 +233,13 @@ fn patch_polygon(
             n += a.p.cross(poly[(k + 1) % poly.len()].p);
         }
     }
-    if n.dot(view.eye - poly[0].p) <= 0.0 {
+    // Seen from the front: towards the eye, or against the direction of a parallel view.
+    let towards_viewer = if view.parallel {
+        -view.fwd
+    } else {
+        view.eye - poly[0].p
+    };
+    if n.dot(towards_viewer) <= 0.0 {
         return false;
     }
     for v in poly.iter_mut() {
@@ -273,8 +288,12 @@ fn project_fan(poly: &[ClipVert], view: &View, out: &mut Vec<ScreenTri>) {
     }
     let proj = |v: &ClipVert| {
         let [x, y] = view.to_screen(v.p);
-        let w = 1.0 / v.p.z;
-        (x, y, w, v.c * w)
+        let (w, key) = if view.parallel {
+            (1.0, -v.p.z)
+        } else {
+            (1.0 / v.p.z, 1.0 / v.p.z)
+        };
+        (x, y, w, v.c * w, key)
     };
     let a = proj(&poly[0]);
     for k in 1..poly.len() - 1 {
@@ -284,10 +303,16 @@ fn project_fan(poly: &[ClipVert], view: &View, out: &mut Vec<ScreenTri>) {
             y: [a.1, b.1, c.1],
             w: [a.2, b.2, c.2],
             cw: [a.3, b.3, c.3],
+            key: [a.4, b.4, c.4],
         };
         let area = (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0);
-        let finite = t.x.iter().chain(&t.y).chain(&t.w).all(|v| v.is_finite())
-            && t.cw.iter().all(|c| c.is_finite());
+        let finite =
+            t.x.iter()
+                .chain(&t.y)
+                .chain(&t.w)
+                .chain(&t.key)
+                .all(|v| v.is_finite())
+                && t.cw.iter().all(|c| c.is_finite());
         if finite && area != 0.0 {
             out.push(t);
         }
@@ -354,10 +379,11 @@ fn rasterize(
                 continue;
             }
             let b = [e[0] / sum, e[1] / sum, e[2] / sum];
-            let w = b[0] * t.w[0] + b[1] * t.w[1] + b[2] * t.w[2];
+            let key = b[0] * t.key[0] + b[1] * t.key[1] + b[2] * t.key[2];
             let i = base + sx;
-            if w > depth[i] {
-                depth[i] = w;
+            if key > depth[i] {
+                depth[i] = key;
+                let w = b[0] * t.w[0] + b[1] * t.w[1] + b[2] * t.w[2];
                 colour[i] = (b[0] * t.cw[0] + b[1] * t.cw[1] + b[2] * t.cw[2]) / w;
             }
         }

@@ -1,5 +1,5 @@
-//! `radiosity render`: a saved solution to PNG (tone-mapped, or irradiance in false colour),
-//! Radiance HDR or OpenEXR.
+//! `radiosity render`: a saved solution to PNG (tone-mapped radiosity, or irradiance in false
+//! colour), Radiance HDR or OpenEXR (radiance, W/sr/m²: [`crate::export::image`]).
 
 use super::{bounds, load_checked, OutputReport, SceneCheck};
 use crate::export::image::{self as image_out, ImageKind};
@@ -15,7 +15,7 @@ use std::path::PathBuf;
 pub struct RenderJob {
     pub solution: PathBuf,
     pub check: Option<SceneCheck>,
-    /// `.png`, `.hdr` or `.exr`.
+    /// `.png`, `.hdr` or `.exr` (the last two in radiance, B/π).
     pub out: PathBuf,
     pub view: ViewSettings,
     /// Irradiance in false colour with a legend (PNG only).
@@ -68,8 +68,8 @@ pub(crate) fn render_loaded(
                 exposure = Some(e);
                 write_atomic(&job.out, |w| image_out::write_png(w, &img))?;
             }
-            ImageKind::Hdr => write_atomic(&job.out, |w| image_out::write_hdr(w, &lin))?,
-            ImageKind::Exr => write_atomic(&job.out, |w| image_out::write_exr(w, &lin))?,
+            ImageKind::Hdr => write_atomic(&job.out, |w| image_out::write_hdr(w, &lin, &cam))?,
+            ImageKind::Exr => write_atomic(&job.out, |w| image_out::write_exr(w, &lin, &cam))?,
         }
     }
     Ok(OutputReport {

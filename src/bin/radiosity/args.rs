@@ -6,7 +6,8 @@ use clap::Args;
 use glam::Vec3;
 use radiosity::intersect::select::IntersectorKind;
 use radiosity::mesh::MeshOptions;
-use radiosity::render::view::{DEFAULT_HEIGHT, DEFAULT_SUPERSAMPLE, DEFAULT_WIDTH};
+use radiosity::render::view::{image_size, DEFAULT_SUPERSAMPLE};
+use radiosity::render::view_file::RadianceView;
 use radiosity::render::{CameraSpec, RenderOptions, ViewSettings};
 use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
@@ -257,6 +258,12 @@ impl SolverArgs {
 /// The camera and the image (`solve`, `render`, `relight`).
 #[derive(Args)]
 pub struct ViewArgs {
+    /// The camera from a Radiance view file, as `rvu` saves and `rpict -vf` reads
+    /// (`rvu -vtv -vp X Y Z -vd X Y Z -vu X Y Z -vh DEG -vv DEG …`, or a picture's `VIEW=`
+    /// line; perspective -vtv and parallel -vtl). The picture is exactly the view's field:
+    /// its aspect comes from -vh/-vv (see --width). Not with --eye/--target/--up/--fov.
+    #[arg(long, value_name = "FILE")]
+    pub view: Option<PathBuf>,
     /// Camera position X,Y,Z (default: fitted to the scene, looking along −z).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<Vec3>,
@@ -269,10 +276,20 @@ pub struct ViewArgs {
     /// Vertical field of view in degrees.
     #[arg(long, allow_negative_numbers = true)]
     pub fov: Option<f32>,
-    #[arg(long, default_value_t = DEFAULT_WIDTH)]
-    pub width: u32,
-    #[arg(long, default_value_t = DEFAULT_HEIGHT)]
-    pub height: u32,
+    /// Nothing nearer than this distance along the view direction is drawn (metres, scene
+    /// units): a camera inside a wall's thickness, or behind a wall, sees past it. Radiance's
+    /// -vo; overrides a view file's [default: a tiny distance, nothing clipped].
+    #[arg(long, value_name = "DIST", allow_negative_numbers = true)]
+    pub near: Option<f32>,
+    /// Image width in pixels [default: 640]. With --view the height follows from the view's
+    /// aspect; with --view, --width and --height together are a box the picture is fitted
+    /// into (the side too long for the view shrinks, as rpict -x -y).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels [default: 480]. With --view alone, it sets the height and the
+    /// width follows.
+    #[arg(long)]
+    pub height: Option<u32>,
     /// Samples per pixel along each axis (edges anti-aliased by s×s supersampling).
     #[arg(long, default_value_t = DEFAULT_SUPERSAMPLE)]
     pub supersample: u32,
@@ -282,21 +299,30 @@ pub struct ViewArgs {
 }
 
 impl ViewArgs {
-    pub fn settings(&self) -> ViewSettings {
-        ViewSettings {
-            camera: CameraSpec {
-                eye: self.eye,
-                target: self.target,
-                up: self.up,
-                fov_y_deg: self.fov,
-            },
+    /// The view; an unreadable or bad `--view` file is an error naming it.
+    pub fn settings(&self) -> Result<ViewSettings, radiosity::Error> {
+        let view = match &self.view {
+            Some(path) => Some(RadianceView::read(path)?),
+            None => None,
+        };
+        let camera = CameraSpec {
+            eye: self.eye,
+            target: self.target,
+            up: self.up,
+            fov_y_deg: self.fov,
+            near: self.near,
+            view,
+        };
+        let (width, height) = image_size(&camera, self.width, self.height);
+        Ok(ViewSettings {
+            camera,
             image: RenderOptions {
-                width: self.width,
-                height: self.height,
+                width,
+                height,
                 supersample: self.supersample,
                 exposure: self.exposure,
             },
-        }
+        })
     }
 }
 

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 pub struct RenderArgs {
     /// The saved solution (`radiosity solve --save FILE.rad`).
     solution: PathBuf,
-    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiosity, W/m²).
+    /// Image to write: .png (tone-mapped sRGB), .hdr or .exr (linear radiance, W/sr/m²: the
+    /// radiosity over π, as Radiance's rpict writes).
     #[arg(long)]
     out: PathBuf,
     #[command(flatten)]
@@ -29,14 +30,14 @@ pub struct RenderArgs {
 }
 
 impl RenderArgs {
-    fn job(&self) -> RenderJob {
-        RenderJob {
+    fn job(&self) -> Result<RenderJob, radiosity::Error> {
+        Ok(RenderJob {
             solution: self.solution.clone(),
             check: self.check.check(),
             out: self.out.clone(),
-            view: self.view.settings(),
+            view: self.view.settings()?,
             false_colour: self.false_colour,
-        }
+        })
     }
 }
 
@@ -71,14 +72,14 @@ pub struct RelightArgs {
 }
 
 pub fn render(a: RenderArgs) -> Result<(), radiosity::Error> {
-    let r = saved::run_render(&a.job())?;
+    let r = saved::run_render(&a.job()?)?;
     print_report(&r, a.json, a.quiet);
     Ok(())
 }
 
 pub fn relight(a: RelightArgs) -> Result<(), radiosity::Error> {
     let job = RelightJob {
-        render: a.render.job(),
+        render: a.render.job()?,
         weights: a.weights,
     };
     let r = saved::run_relight(&job)?;
@@ -106,7 +107,7 @@ fn print_report(r: &OutputReport, json: bool, quiet: bool) {
         let extra = match (&r.scale, r.exposure) {
             (Some(s), _) => format!(", irradiance {}–{} W/m² on a log scale", s.lo, s.hi),
             (None, Some(e)) => format!(", exposure {e:.4}"),
-            (None, None) => ", linear radiosity in W/m²".to_string(),
+            (None, None) => ", radiance in W/sr/m² (radiosity/π)".to_string(),
         };
         outln!(
             "{}: {} of {} ({} patches, {} vertices){extra}",

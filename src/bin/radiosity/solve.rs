@@ -76,7 +76,7 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
             intersector: a.solve_args.intersector(),
             per_light: a.per_light.then_some(a.light_groups.into()),
         },
-        view: a.view.settings(),
+        view: a.view.settings()?,
         out: a.out.clone(),
         reference: a.reference,
         save: a.save.clone(),
