@@ -56,6 +56,24 @@ pub struct SavedMaterial {
     pub rho: [f64; 3],
     /// Emitted radiance, W/sr/m² (E = π·Ke).
     pub ke: [f64; 3],
+    /// Glazing: the share of light that goes straight through (`Material::transmittance`), so
+    /// that `render --shading gather` sees through panes; 0 in files written before it was
+    /// kept (panes then look opaque).
+    #[serde(default)]
+    pub transmittance: f64,
+}
+
+impl SavedMaterial {
+    /// The material as the solver knew it (what a saved file keeps of it).
+    pub fn material(&self) -> crate::scene::Material {
+        crate::scene::Material {
+            name: self.name.clone(),
+            rho: self.rho,
+            ke: self.ke,
+            rho_source: crate::scene::RhoSource::Kd,
+            transmittance: self.transmittance,
+        }
+    }
 }
 
 /// The settings and provenance of a saved solution (the `META` section, JSON).
@@ -638,6 +656,7 @@ mod tests {
                     name: "m".into(),
                     rho: [0.5; 3],
                     ke: [1.0; 3],
+                    transmittance: 0.0,
                 }],
                 settings: serde_json::Value::Null,
             },

@@ -104,6 +104,8 @@ pub struct SolveJob {
     pub grid: Option<crate::grid::GridSpec>,
     /// Rays each sensor gathers (`--grid-rays`).
     pub grid_rays: usize,
+    /// How `render.png` is shaded (`--shading`, `--pixel-rays`; the seed is the solve's).
+    pub shading: crate::render::ShadingSettings,
 }
 
 /// Seconds between checkpoints by default (`--checkpoint-every`).
@@ -125,6 +127,7 @@ impl SolveJob {
             interrupt: None,
             grid: None,
             grid_rays: daylight::DEFAULT_GRID_RAYS,
+            shading: Default::default(),
         }
     }
 
@@ -132,6 +135,7 @@ impl SolveJob {
     pub fn check(&self) -> Result<(), Invalid> {
         self.settings.check()?;
         self.view.check()?;
+        self.shading.check()?;
         if (self.checkpoint.is_some() || self.resume.is_some())
             && self.settings.solve.method == MethodKind::Gathering
         {
@@ -220,6 +224,7 @@ fn solve_into(
         sol: &sol,
         timings,
         t0,
+        progress,
     };
     let summary = outputs::write(job, &run, log, written)?;
     progress.finish();

@@ -20,12 +20,14 @@
 
 mod camera;
 pub mod false_colour;
+pub mod gather;
 pub mod glyphs;
 mod raster;
 mod tone;
 pub mod view;
 
 pub use camera::Camera;
+pub use gather::{render_gather, Shading, ShadingSettings};
 pub use tone::{auto_exposure, srgb_encode, tone_map};
 pub use view::{CameraSpec, ViewSettings};
 

@@ -6,8 +6,9 @@ use clap::Args;
 use glam::Vec3;
 use radiosity::intersect::select::IntersectorKind;
 use radiosity::mesh::MeshOptions;
+use radiosity::render::gather::DEFAULT_PIXEL_RAYS;
 use radiosity::render::view::{DEFAULT_HEIGHT, DEFAULT_SUPERSAMPLE, DEFAULT_WIDTH};
-use radiosity::render::{CameraSpec, RenderOptions, ViewSettings};
+use radiosity::render::{CameraSpec, RenderOptions, Shading, ShadingSettings, ViewSettings};
 use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
 use radiosity::solve::lights::GroupBy;
@@ -297,6 +298,62 @@ impl ViewArgs {
                 exposure: self.exposure,
             },
         }
+    }
+}
+
+/// How a picture is shaded (`solve`, `render`, `relight`).
+#[derive(Args)]
+pub struct ShadingArgs {
+    /// gather: each pixel gathers its light with rays (direct light sampled with shadow rays,
+    /// so shadows are sharp whatever the patch size; indirect light from the solved radiosity);
+    /// gouraud: the solution's patches interpolated at their vertices, the fast preview.
+    #[arg(long, value_enum, default_value_t = ShadingArg::from(Shading::default()))]
+    pub shading: ShadingArg,
+    /// --shading gather: rays gathered per anti-aliasing sample (half to the lights, the rest
+    /// over the hemisphere); --supersample sets the samples per pixel.
+    #[arg(long, default_value_t = DEFAULT_PIXEL_RAYS, value_name = "N")]
+    pub pixel_rays: usize,
+}
+
+impl ShadingArgs {
+    /// The settings, with the pixels' random numbers seeded by `seed`.
+    pub fn settings(&self, seed: u64) -> ShadingSettings {
+        ShadingSettings {
+            shading: self.shading.into(),
+            rays: self.pixel_rays,
+            seed,
+        }
+    }
+}
+
+/// `--shading`: see `radiosity::render::Shading`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum ShadingArg {
+    Gather,
+    Gouraud,
+}
+
+impl From<Shading> for ShadingArg {
+    fn from(s: Shading) -> ShadingArg {
+        match s {
+            Shading::Gather => ShadingArg::Gather,
+            Shading::Gouraud => ShadingArg::Gouraud,
+        }
+    }
+}
+
+impl From<ShadingArg> for Shading {
+    fn from(s: ShadingArg) -> Shading {
+        match s {
+            ShadingArg::Gather => Shading::Gather,
+            ShadingArg::Gouraud => Shading::Gouraud,
+        }
+    }
+}
+
+impl std::fmt::Display for ShadingArg {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(Shading::from(*self).name())
     }
 }
 
