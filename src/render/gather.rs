@@ -60,10 +60,11 @@ pub const MAX_PIXEL_RAYS: usize = 65_536;
 #[serde(rename_all = "lowercase")]
 pub enum Shading {
     /// The solution's B per patch, averaged to the welded vertices and Gouraud-interpolated
-    /// ([`super::render_linear`]): the fast preview, as the paper shows its images.
-    Gouraud,
-    /// A final gather per pixel ([`render_gather`]).
+    /// ([`super::render_linear`]): the fast preview, as the paper shows its images; the
+    /// library's default and `solve`'s (its picture is a by-product of the solve).
     #[default]
+    Gouraud,
+    /// A final gather per pixel ([`render_gather`]): `render`'s and `relight`'s default.
     Gather,
 }
 

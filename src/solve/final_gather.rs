@@ -77,6 +77,7 @@ use rand::seq::SliceRandom;
 use rand::Rng;
 use rayon::prelude::*;
 use std::borrow::Cow;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// The "shot number" the gather's random numbers are drawn under (never a real shot's).
@@ -287,6 +288,7 @@ pub fn sensor_irradiance<I: Intersector>(
                 ctx.eps_floor,
                 [1.0; 3],
                 ctx.rays,
+                true,
                 &mut rng,
             )
             .h
@@ -386,13 +388,24 @@ impl<I: Intersector> Ctx<'_, I> {
         let points = PatchPoints::new(self.mesh, i);
         let mut rng = rng_for(self.seed, GATHER_STREAM, i as u64);
         let at = |u: f32, v: f32| points.at(u, v);
-        self.gather_at(i, &at, patch.normal, eps, self.rho[i], self.rays, &mut rng)
+        self.gather_at(
+            i,
+            &at,
+            patch.normal,
+            eps,
+            self.rho[i],
+            self.rays,
+            true,
+            &mut rng,
+        )
     }
 
     /// The gather at the points `at(u, v)` of the unit square's map (a patch's, or one
     /// sensor's point) facing `n`, rays leaving patch `i`'s surface ([`NO_PATCH`] for a
     /// sensor in the air); `rho` weighs the channels of the variance; `rays` in all (half to
     /// the emitters, a quarter to the sun when there is one, the rest over the hemisphere).
+    /// `lights` false sends the emitters' half over the hemisphere too: for points no emitter
+    /// faces, which a hemisphere ray then cannot meet on its emitting side either.
     #[allow(clippy::too_many_arguments)]
     fn gather_at<R: Rng>(
         &self,
@@ -402,6 +415,7 @@ impl<I: Intersector> Ctx<'_, I> {
         eps: f32,
         rho: [f64; 3],
         rays_wanted: usize,
+        lights: bool,
         rng: &mut R,
     ) -> Gathered {
         let mesh = self.mesh;
@@ -411,7 +425,7 @@ impl<I: Intersector> Ctx<'_, I> {
         let mut var = 0.0;
         let mut rays = 0u64;
         // Half the rays to the emitters (when there are any), half over the hemisphere.
-        let n_direct = if self.emitters.is_empty() {
+        let n_direct = if self.emitters.is_empty() || !lights {
             0
         } else {
             (rays_wanted / 2).max(1)
@@ -992,7 +1006,13 @@ pub fn apply<I: Intersector>(
 /// sun and glazing. Built once per image; shared by every thread.
 pub struct PointGather<'a, I> {
     ctx: Ctx<'a, I>,
+    /// Per patch, once asked: whether any emitter faces it ([`PointGather::radiosity_at`]).
+    facing: Vec<OnceLock<bool>>,
 }
+
+/// Above this many emitting patches, every patch is taken as facing one (the test is O(emitters)
+/// per patch seen).
+const FACING_TEST_MAX: usize = 4096;
 
 /// What a ray from the camera met ([`PointGather::view`]).
 #[derive(Clone, Copy, Debug)]
@@ -1057,7 +1077,36 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         let mut ctx = Ctx::new(mesh, materials, isect, inputs, 0, 4, sky);
         ctx.sky_weight = sky_weight;
         ctx.sun_weight = sun_weight;
-        PointGather { ctx }
+        PointGather {
+            ctx,
+            facing: (0..mesh.patches.len()).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// Whether some emitter could light `patch`: one with a corner in front of the patch's
+    /// plane while the patch has a corner in front of the emitter's (a planar emitter lights
+    /// its front only; a patch receives on its front only). When none does — a ceiling beside
+    /// its flush lamps — light samples could only miss, so the gather's rays all go over the
+    /// hemisphere instead: half the noise variance where the picture is lit indirectly alone.
+    fn lit_by_an_emitter(&self, patch: usize) -> bool {
+        let ctx = &self.ctx;
+        if ctx.emitters.len() > FACING_TEST_MAX {
+            return true;
+        }
+        let mesh = ctx.mesh;
+        let tol = ctx.eps_floor;
+        let corners = |i: usize| {
+            mesh.patch_indices(i)
+                .iter()
+                .map(|&v| mesh.vertices[v as usize])
+        };
+        let in_front = |i: usize, of: usize| {
+            let (n, c) = (mesh.patches[of].normal, mesh.patches[of].centre);
+            corners(i).any(|v| n.dot(v - c) > tol)
+        };
+        ctx.emitters
+            .iter()
+            .any(|&j| j != patch && in_front(j, patch) && in_front(patch, j))
     }
 
     /// What the ray from `org` along `dir` sees. The backs of one-sided patches are passed
@@ -1122,7 +1171,8 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         let eps = (1e-4 * (p.area as f32).sqrt()).max(ctx.eps_floor);
         let m = points.len();
         let at = |u: f32, _: f32| points[((u * m as f32) as usize).min(m - 1)];
-        let g = ctx.gather_at(patch, &at, p.normal, eps, rho, rays.max(2), rng);
+        let lights = *self.facing[patch].get_or_init(|| self.lit_by_an_emitter(patch));
+        let g = ctx.gather_at(patch, &at, p.normal, eps, rho, rays.max(2), lights, rng);
         let b = [0, 1, 2].map(|q| {
             let v = e[q] + rho[q] * g.h[q];
             if v.is_finite() {

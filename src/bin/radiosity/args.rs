@@ -306,9 +306,10 @@ impl ViewArgs {
 pub struct ShadingArgs {
     /// gather: each pixel gathers its light with rays (direct light sampled with shadow rays,
     /// so shadows are sharp whatever the patch size; indirect light from the solved radiosity);
-    /// gouraud: the solution's patches interpolated at their vertices, the fast preview.
-    #[arg(long, value_enum, default_value_t = ShadingArg::from(Shading::default()))]
-    pub shading: ShadingArg,
+    /// gouraud: the solution's patches interpolated at their vertices, the fast preview
+    /// [default: gather for render and relight, gouraud for solve]
+    #[arg(long, value_enum)]
+    pub shading: Option<ShadingArg>,
     /// --shading gather: rays gathered per anti-aliasing sample (half to the lights, the rest
     /// over the hemisphere); --supersample sets the samples per pixel.
     #[arg(long, default_value_t = DEFAULT_PIXEL_RAYS, value_name = "N")]
@@ -316,10 +317,11 @@ pub struct ShadingArgs {
 }
 
 impl ShadingArgs {
-    /// The settings, with the pixels' random numbers seeded by `seed`.
-    pub fn settings(&self, seed: u64) -> ShadingSettings {
+    /// The settings, with the pixels' random numbers seeded by `seed`; `default` where
+    /// `--shading` is left out (the command's own).
+    pub fn settings(&self, seed: u64, default: Shading) -> ShadingSettings {
         ShadingSettings {
-            shading: self.shading.into(),
+            shading: self.shading.map_or(default, Shading::from),
             rays: self.pixel_rays,
             seed,
         }
@@ -333,27 +335,12 @@ pub enum ShadingArg {
     Gouraud,
 }
 
-impl From<Shading> for ShadingArg {
-    fn from(s: Shading) -> ShadingArg {
-        match s {
-            Shading::Gather => ShadingArg::Gather,
-            Shading::Gouraud => ShadingArg::Gouraud,
-        }
-    }
-}
-
 impl From<ShadingArg> for Shading {
     fn from(s: ShadingArg) -> Shading {
         match s {
             ShadingArg::Gather => Shading::Gather,
             ShadingArg::Gouraud => Shading::Gouraud,
         }
-    }
-}
-
-impl std::fmt::Display for ShadingArg {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(Shading::from(*self).name())
     }
 }
 

@@ -4,6 +4,7 @@ use crate::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs};
 use crate::outln;
 use clap::Args;
 use radiosity::progress::Progress;
+use radiosity::render::Shading;
 use radiosity::saved::{self, ExportJob, OutputReport, RelightJob, RenderJob};
 use std::path::PathBuf;
 
@@ -43,7 +44,7 @@ impl RenderArgs {
             out: self.out.clone(),
             view: self.view.settings(),
             false_colour: self.false_colour,
-            shading: self.shading.settings(self.seed),
+            shading: self.shading.settings(self.seed, Shading::Gather),
         }
     }
 }

@@ -89,7 +89,9 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
         interrupt: Some(interrupt_flag()),
         grid: a.sky.grid.clone(),
         grid_rays: a.sky.grid_rays,
-        shading: a.shading.settings(solve_seed),
+        shading: a
+            .shading
+            .settings(solve_seed, radiosity::render::Shading::Gouraud),
     };
     let quiet = a.quiet || a.json;
     let progress = Progress::for_terminal(quiet);
