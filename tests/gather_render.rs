@@ -359,3 +359,130 @@ fn the_commands_take_the_shading_flags() {
         &["--pixel-rays", "between 1 and"],
     );
 }
+
+/// `relight --shading gather` gathers the relit lights: the furnace's light at weight 2 gives
+/// exactly twice the picture of weight 1 (radiosity is linear in the emission, and the same
+/// seed draws the same samples), at weight 0 a black one.
+#[test]
+fn relight_gathers_the_reweighted_lights() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("f.mtl"), FURNACE_MTL).unwrap();
+    let obj = d.join("furnace.obj");
+    std::fs::write(&obj, FURNACE_OBJ).unwrap();
+    let sol = d.join("s.rad");
+    let (code, _, err) = run(&[
+        "solve",
+        s(&obj),
+        "--out",
+        s(&d.join("o")),
+        "--save",
+        s(&sol),
+        "--per-light",
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let picture = |weight: &str| {
+        let out = d.join(format!("r{weight}.exr"));
+        let (code, _, err) = run(&[
+            "relight",
+            s(&sol),
+            "--weight",
+            &format!("glow={weight}"),
+            "--out",
+            s(&out),
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--pixel-rays",
+            "8",
+        ]);
+        assert_eq!(code, 0, "{err}");
+        image::open(&out).unwrap().to_rgb32f()
+    };
+    let (one, two, zero) = (picture("1"), picture("2"), picture("0"));
+    let mut lit = 0;
+    for ((a, b), z) in one.pixels().zip(two.pixels()).zip(zero.pixels()) {
+        for q in 0..3 {
+            // The background (the fitted camera looks in from outside) stays black.
+            if a.0[q] > 0.0 {
+                lit += 1;
+                assert!(
+                    (b.0[q] / a.0[q] - 2.0).abs() < 1e-4,
+                    "{} vs {}",
+                    b.0[q],
+                    a.0[q]
+                );
+            } else {
+                assert_eq!(b.0[q], 0.0);
+            }
+            assert_eq!(z.0[q], 0.0);
+        }
+    }
+    assert!(lit > 32 * 24, "{lit} lit channels");
+}
+
+/// A daylit solve's sky is rebuilt from the settings its saved file keeps: the gathered
+/// picture of a roofless room under a uniform sky shows the sky, uniform, where it looks out,
+/// and says nothing about a sky it could not rebuild.
+#[test]
+fn a_saved_daylit_solve_renders_with_its_sky() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A 2 × 1 × 2 m room without a roof, faces wound to look in.
+    let obj = d.join("court.obj");
+    std::fs::write(
+        &obj,
+        "mtllib c.mtl\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 0 0 2\nv 2 0 2\nv 2 1 2\nv 0 1 2\n\
+         usemtl stone\nf 1 5 6 2\nf 1 2 3 4\nf 5 8 7 6\nf 1 4 8 5\nf 2 6 7 3\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("c.mtl"), "newmtl stone\nKd 0.5 0.5 0.5\n").unwrap();
+    let sol = d.join("s.rad");
+    let (code, _, err) = run(&[
+        "solve",
+        s(&obj),
+        "--sky",
+        "uniform",
+        "--out",
+        s(&d.join("o")),
+        "--save",
+        s(&sol),
+        "--quiet",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let out = d.join("up.exr");
+    let (code, stdout, err) = run(&[
+        "render",
+        s(&sol),
+        "--out",
+        s(&out),
+        "--eye",
+        "1,0.2,1",
+        "--target",
+        "1,1,1.01",
+        "--fov",
+        "120",
+        "--width",
+        "40",
+        "--height",
+        "40",
+        "--pixel-rays",
+        "8",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(report["shading"], "gather");
+    assert!(report.get("warnings").is_none(), "{report}");
+    // The centre looks straight up at the open sky.
+    let img = image::open(&out).unwrap().to_rgb32f();
+    let sky = img.get_pixel(20, 20).0;
+    assert!(sky[1] > 0.0);
+    for (x, y) in [(18, 18), (22, 21), (19, 23)] {
+        let p = img.get_pixel(x, y).0;
+        assert!((p[1] / sky[1] - 1.0).abs() < 1e-3, "{p:?} against {sky:?}");
+    }
+}
