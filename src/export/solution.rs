@@ -531,7 +531,8 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
                 3 => PatchClass::Skew,
                 _ => return None,
             },
-            // The file keeps no twins: a saved solution is drawn, never cast into (§7).
+            // The file keeps no twins (§7); `Mesh::pair_twins` finds them again for a
+            // picture that casts rays into the solution (`render --shading gather`).
             side: Side::One,
         })
     })?;

@@ -1,5 +1,7 @@
-//! Display of a radiosity solution: camera, CPU rasterizer and tone mapping; [`false_colour`]
-//! (irradiance on a log scale with a legend) and [`glyphs`] (the legend's digits) beside it.
+//! Display of a radiosity solution: camera, CPU rasterizer and tone mapping; [`gather`] (the
+//! final-gather renderer, `--shading gather`: each pixel gathers its light with rays, the
+//! solution as the cache of the indirect light), [`false_colour`] (irradiance on a log scale
+//! with a legend) and [`glyphs`] (the legend's digits) beside it.
 //!
 //! The paper shows its solutions the classic way: radiosity is averaged to the patch vertices
 //! and Gouraud-interpolated across each patch. [`render_linear`] does exactly that in software:
