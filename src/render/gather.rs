@@ -187,6 +187,13 @@ impl Pinhole {
     }
 }
 
+/// `sum` += `w`·`v`, per channel.
+fn add(sum: &mut [f64; 3], v: [f64; 3], w: f64) {
+    for (s, v) in sum.iter_mut().zip(v) {
+        *s += w * v;
+    }
+}
+
 /// The samples of one pixel that met one side: its points and their weight (the glazing's
 /// transmittance before them, summed).
 struct Group {
@@ -244,9 +251,7 @@ pub fn render_gather<I: Intersector>(
                     };
                     let seen = gather.view(cam.eye, dir);
                     cast += seen.rays;
-                    for q in 0..3 {
-                        sum[q] += seen.panes[q];
-                    }
+                    add(&mut sum, seen.panes, 1.0);
                     match seen.hit {
                         Some(h) => match groups.iter_mut().find(|g| g.patch == h.patch) {
                             Some(g) => {
@@ -260,10 +265,7 @@ pub fn render_gather<I: Intersector>(
                             }),
                         },
                         None => {
-                            let sky = gather.sky_exitance(dir);
-                            for q in 0..3 {
-                                sum[q] += seen.through * sky[q];
-                            }
+                            add(&mut sum, gather.sky_exitance(dir), seen.through);
                         }
                     }
                 }
@@ -271,9 +273,7 @@ pub fn render_gather<I: Intersector>(
                     let (b, n) =
                         gather.radiosity_at(g.patch, &g.points, rays * g.points.len(), &mut rng);
                     cast += n;
-                    for q in 0..3 {
-                        sum[q] += g.weight * b[q];
-                    }
+                    add(&mut sum, b, g.weight);
                 }
                 *px = sum.map(|v| {
                     let v = (v / (s * s) as f64) as f32;
