@@ -117,6 +117,45 @@ impl Mesh {
         let p = &self.patches[i];
         &self.patch_vertices[p.first as usize..(p.first + p.count) as usize]
     }
+
+    /// Pairs the back twins of a mesh that lost its sides (a saved solution keeps none,
+    /// docs/design.md §7) again, so that rays cast into it meet each surface once and a back
+    /// hit goes to the twin: a one-sided patch of the same polygon, centre and area as an
+    /// earlier one, and the exactly opposite normal, is that one's twin (the builder copies
+    /// them from the front; a twin always comes after its front). Returns the pairs made.
+    pub fn pair_twins(&mut self) -> usize {
+        type Key = (u32, [u32; 3], u64);
+        let key = |p: &Patch| -> Key {
+            (
+                p.polygon,
+                p.centre.to_array().map(f32::to_bits),
+                p.area.to_bits(),
+            )
+        };
+        let mut open: HashMap<Key, Vec<usize>> = HashMap::new();
+        let mut pairs = 0;
+        for i in 0..self.patches.len() {
+            let p = self.patches[i];
+            if p.side != Side::One {
+                continue;
+            }
+            let k = key(&p);
+            let list = open.entry(k).or_default();
+            let front = list
+                .iter()
+                .position(|&j| self.patches[j].normal == -p.normal && p.normal != Vec3::ZERO);
+            match front {
+                Some(at) => {
+                    let j = list.swap_remove(at);
+                    self.patches[j].side = Side::Front { back: i as u32 };
+                    self.patches[i].side = Side::Back { front: j as u32 };
+                    pairs += 1;
+                }
+                None => list.push(i),
+            }
+        }
+        pairs
+    }
 }
 
 use crate::scene::Scene;
@@ -816,6 +855,22 @@ mod tests {
             "4 quads, 2 triangles each"
         );
         assert_eq!(m.triangles().count(), 16);
+    }
+
+    #[test]
+    fn twins_lost_by_a_saved_solution_are_paired_again() {
+        let quad = UNIT_QUAD;
+        let mut s = scene_of(&[&quad, &quad.map(|v| v + Vec3::Z)]);
+        s.polygons[1].back_material = Some(0);
+        // Polygon 0 one-sided, polygon 1 two-sided (a merged doubled face), 4 patches each side.
+        let m = build(&s, &opts(0.5));
+        assert_eq!(m.back_twins(), 4);
+        let mut lost = m.clone();
+        lost.patches.iter_mut().for_each(|p| p.side = Side::One);
+        assert_eq!(lost.pair_twins(), 4);
+        assert_eq!(lost, m);
+        // Pairing again finds nothing more.
+        assert_eq!(lost.pair_twins(), 0);
     }
 
     #[test]

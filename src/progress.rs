@@ -92,6 +92,26 @@ impl Progress {
         }
     }
 
+    /// Starts a bar of `total` units of work done by many threads at once (the rows of a
+    /// final-gather picture), labelled `what`; the [`Counter`] it returns is moved on from any
+    /// thread. Hidden (a counter that does nothing) when bars are off.
+    pub fn start_count(&self, what: &str, total: u64) -> Counter {
+        if !self.enabled {
+            return Counter(None);
+        }
+        let pb = ProgressBar::new(total);
+        pb.set_style(
+            ProgressStyle::with_template(&format!(
+                "{what} [{{bar:20}}] {{percent:>3}}%, eta {{eta}}"
+            ))
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        pb.enable_steady_tick(Duration::from_millis(250));
+        self.replace(Some(pb.clone()));
+        Counter(Some(pb))
+    }
+
     /// Prints a line on standard error without tearing the bar.
     pub fn println(&self, line: &str) {
         match &*self.bar.borrow() {
@@ -115,6 +135,23 @@ impl Progress {
 impl Drop for Progress {
     fn drop(&mut self) {
         self.finish();
+    }
+}
+
+/// Moves a [`Progress::start_count`] bar on; shared by the threads doing the work.
+pub struct Counter(Option<ProgressBar>);
+
+impl Counter {
+    /// A counter without a bar.
+    pub fn hidden() -> Counter {
+        Counter(None)
+    }
+
+    /// `n` more units done.
+    pub fn inc(&self, n: u64) {
+        if let Some(pb) = &self.0 {
+            pb.inc(n);
+        }
     }
 }
 
@@ -158,5 +195,8 @@ mod tests {
             ..TracePoint::default()
         });
         assert!(p.bar.borrow().is_none());
+        let c = p.start_count("rendering", 10);
+        c.inc(3);
+        assert!(c.0.is_none() && p.bar.borrow().is_none());
     }
 }

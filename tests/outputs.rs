@@ -51,13 +51,16 @@ fn furnace(dir: &Path) -> PathBuf {
     obj
 }
 
-/// Renders from the cube's centre towards a wall, which fills the view.
+/// Renders from the cube's centre towards a wall, which fills the view: the Gouraud picture,
+/// exact for an exact solution (the gathered one is checked in tests/gather_render.rs).
 fn render_inside(sol: &Path, out: &Path) {
     ok(&[
         "render",
         s(sol),
         "--out",
         s(out),
+        "--shading",
+        "gouraud",
         "--eye",
         "0.5,0.5,0.5",
         "--target",

@@ -1,7 +1,8 @@
 //! Issue 15's view flags and picture units as a user meets them: `render --view FILE` (a
 //! Radiance view file) gives the view's field and aspect, `--near` clips, and `.hdr`/`.exr`
 //! pixels are radiance B/π with the view and the unit in the header; bad view files are refused
-//! with one line and exit code 2.
+//! with one line and exit code 2. Pictures are drawn `--shading gouraud`, whose pixels are exact
+//! (the gather's noise is `tests/gather_render.rs`'s business).
 
 mod common;
 
@@ -94,6 +95,8 @@ fn render_with_a_view_file_draws_its_field_in_radiance() {
     let hdr = dir.path().join("v.hdr");
     let out = ok(&[
         "render",
+        "--shading",
+        "gouraud",
         s(&sol),
         "--view",
         s(&view),
@@ -132,6 +135,8 @@ fn render_with_a_view_file_draws_its_field_in_radiance() {
     let exr = dir.path().join("v.exr");
     ok(&[
         "render",
+        "--shading",
+        "gouraud",
         s(&exact),
         "--view",
         s(&view),
@@ -151,6 +156,8 @@ fn render_with_a_view_file_draws_its_field_in_radiance() {
     let png = dir.path().join("v.png");
     ok(&[
         "render",
+        "--shading",
+        "gouraud",
         s(&sol),
         "--view",
         s(&view),
@@ -173,6 +180,8 @@ fn render_with_a_view_file_draws_its_field_in_radiance() {
     let exr = dir.path().join("par.exr");
     ok(&[
         "render",
+        "--shading",
+        "gouraud",
         s(&exact),
         "--view",
         s(&par),
@@ -207,7 +216,14 @@ fn near_clips_the_wall_in_front_of_the_eye() {
         "--quiet",
     ];
     let out = dir.path().join("a.exr");
-    let mut args = vec!["render", s(&exact), "--out", s(&out)];
+    let mut args = vec![
+        "render",
+        "--shading",
+        "gouraud",
+        s(&exact),
+        "--out",
+        s(&out),
+    ];
     args.extend(look);
     ok(&args);
     assert!(pixels(&out).1.iter().all(|v| (v - FURNACE_L).abs() < 1e-4));
@@ -222,6 +238,8 @@ fn near_clips_the_wall_in_front_of_the_eye() {
     );
     let base = [
         "render",
+        "--shading",
+        "gouraud",
         s(&exact),
         "--out",
         s(&out),
@@ -274,7 +292,7 @@ fn bad_views_are_refused_with_one_line() {
     let out = dir.path().join("x.hdr");
     let missing = dir.path().join("missing.vf");
     let render = |extra: &[&str], needles: &[&str]| {
-        let mut args = vec!["render", s(&sol), "--out", s(&out)];
+        let mut args = vec!["render", "--shading", "gouraud", s(&sol), "--out", s(&out)];
         args.extend(extra);
         assert_user_error(&args, needles);
     };

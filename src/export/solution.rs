@@ -56,6 +56,24 @@ pub struct SavedMaterial {
     pub rho: [f64; 3],
     /// Emitted radiance, W/sr/m² (E = π·Ke).
     pub ke: [f64; 3],
+    /// Glazing: the share of light that goes straight through (`Material::transmittance`), so
+    /// that `render --shading gather` sees through panes; 0 in files written before it was
+    /// kept (panes then look opaque).
+    #[serde(default)]
+    pub transmittance: f64,
+}
+
+impl SavedMaterial {
+    /// The material as the solver knew it (what a saved file keeps of it).
+    pub fn material(&self) -> crate::scene::Material {
+        crate::scene::Material {
+            name: self.name.clone(),
+            rho: self.rho,
+            ke: self.ke,
+            rho_source: crate::scene::RhoSource::Kd,
+            transmittance: self.transmittance,
+        }
+    }
 }
 
 /// The settings and provenance of a saved solution (the `META` section, JSON).
@@ -513,7 +531,8 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
                 3 => PatchClass::Skew,
                 _ => return None,
             },
-            // The file keeps no twins: a saved solution is drawn, never cast into (§7).
+            // The file keeps no twins (§7); `Mesh::pair_twins` finds them again for a
+            // picture that casts rays into the solution (`render --shading gather`).
             side: Side::One,
         })
     })?;
@@ -638,6 +657,7 @@ mod tests {
                     name: "m".into(),
                     rho: [0.5; 3],
                     ke: [1.0; 3],
+                    transmittance: 0.0,
                 }],
                 settings: serde_json::Value::Null,
             },

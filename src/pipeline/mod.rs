@@ -108,6 +108,8 @@ pub struct SolveJob {
     /// up when a grid is asked for without a sky.
     pub zenith: glam::Vec3,
     pub north: glam::Vec3,
+    /// How `render.png` is shaded (`--shading`, `--pixel-rays`; the seed is the solve's).
+    pub shading: crate::render::ShadingSettings,
 }
 
 /// Seconds between checkpoints by default (`--checkpoint-every`).
@@ -131,6 +133,7 @@ impl SolveJob {
             grid_rays: daylight::DEFAULT_GRID_RAYS,
             zenith: crate::sky::DEFAULT_ZENITH,
             north: crate::sky::DEFAULT_NORTH,
+            shading: Default::default(),
         }
     }
 
@@ -138,6 +141,7 @@ impl SolveJob {
     pub fn check(&self) -> Result<(), Invalid> {
         self.settings.check()?;
         self.view.check()?;
+        self.shading.check()?;
         if (self.checkpoint.is_some() || self.resume.is_some())
             && self.settings.solve.method == MethodKind::Gathering
         {
@@ -231,6 +235,7 @@ fn solve_into(
         sol: &sol,
         timings,
         t0,
+        progress,
     };
     let summary = outputs::write(job, &run, log, written)?;
     progress.finish();

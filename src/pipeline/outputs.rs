@@ -8,7 +8,7 @@ use crate::intersect::select::{AnyIntersector, Selection};
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::model::Model;
-use crate::render::{self, Camera, RenderOptions};
+use crate::render::{self, Camera, RenderOptions, Shading, ShadingSettings};
 use crate::report::{self, EnergyReport, Summary, Timings};
 use crate::solve::{self, Solution};
 use crate::Error;
@@ -23,6 +23,8 @@ pub struct Run<'a> {
     pub timings: Timings,
     /// When the run started (for the total time).
     pub t0: Instant,
+    /// The bars (the gathered picture has one).
+    pub progress: &'a crate::progress::Progress,
 }
 
 /// Share of the emitted light lost on back faces above which a solve warns: a consistently
@@ -124,7 +126,18 @@ pub fn write(
 
     let png = job.out.join("render.png");
     let (lo, hi) = scene.bounds();
-    let img = render_solution(m, &sol.b, &job.view.camera_for(lo, hi), &job.view.image);
+    let cam = job.view.camera_for(lo, hi);
+    let img = match job.shading.shading {
+        Shading::Gouraud => render_solution(m, &sol.b, &cam, &job.view.image),
+        Shading::Gather => {
+            let (lin, stats) = gather_picture(job, run, sky.as_ref(), &cam)?;
+            log(&format!(
+                "render.png: final gather, {:.0} rays per pixel, {:.2} s",
+                stats.rays_per_pixel, stats.seconds
+            ));
+            render::tone_map(&lin, job.view.image.exposure).0
+        }
+    };
     write_png(&png, &img)?;
     wrote(png);
     if let Some(save) = &job.save {
@@ -359,6 +372,7 @@ fn save_solution(
                 name: mat.name.clone(),
                 rho: mat.rho,
                 ke: mat.ke,
+                transmittance: mat.transmittance,
             })
             .collect(),
         settings: job.settings.to_json(),
@@ -368,6 +382,43 @@ fn save_solution(
         solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &sol.channels)
     })?;
     Ok(())
+}
+
+/// The final-gather picture of a solve (`--shading gather`), through the solve's intersector
+/// (one is built for the methods that cast no rays), with the solve's sky and seed.
+fn gather_picture(
+    job: &SolveJob,
+    run: &Run,
+    sky: Option<&crate::sky::Sky>,
+    cam: &Camera,
+) -> Result<(render::LinearImage, render::gather::GatherStats), Error> {
+    let built;
+    let isect = match run.isect {
+        Some((i, _)) => i,
+        None => {
+            built = run.model.intersector(job.settings.intersector)?;
+            &built.0
+        }
+    };
+    let m = &run.model.mesh;
+    let gather = crate::solve::final_gather::PointGather::new(
+        m,
+        &run.model.scene.materials,
+        isect,
+        &run.sol.b,
+        sky,
+        None,
+    );
+    let shading = ShadingSettings {
+        seed: job.settings.solve.seed,
+        ..job.shading
+    };
+    let rows = run
+        .progress
+        .start_count("rendering", u64::from(job.view.image.height));
+    let out = render::render_gather(&gather, cam, &job.view.image, &shading, &rows);
+    run.progress.phase("writing outputs");
+    Ok(out)
 }
 
 /// Renders patch radiosities, Gouraud-interpolated at the welded vertices, tone-mapped.

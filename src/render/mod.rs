@@ -1,5 +1,7 @@
-//! Display of a radiosity solution: camera, CPU rasterizer and tone mapping; [`false_colour`]
-//! (irradiance on a log scale with a legend) and [`glyphs`] (the legend's digits) beside it.
+//! Display of a radiosity solution: camera, CPU rasterizer and tone mapping; [`gather`] (the
+//! final-gather renderer, `--shading gather`: each pixel gathers its light with rays, the
+//! solution as the cache of the indirect light), [`false_colour`] (irradiance on a log scale
+//! with a legend) and [`glyphs`] (the legend's digits) beside it.
 //!
 //! The paper shows its solutions the classic way: radiosity is averaged to the patch vertices
 //! and Gouraud-interpolated across each patch. [`render_linear`] does exactly that in software:
@@ -22,6 +24,7 @@
 
 mod camera;
 pub mod false_colour;
+pub mod gather;
 pub mod glyphs;
 mod raster;
 mod tone;
@@ -29,6 +32,7 @@ pub mod view;
 pub mod view_file;
 
 pub use camera::{Camera, Frame, Projection};
+pub use gather::{render_gather, Shading, ShadingSettings};
 pub use tone::{auto_exposure, srgb_encode, tone_map};
 pub use view::{CameraSpec, ViewSettings};
 

@@ -70,5 +70,8 @@ pub(crate) fn export_loaded(
         vertices: sol.mesh.vertices.len(),
         exposure: Some(exposure),
         scale: None,
+        shading: None,
+        gather: None,
+        warnings: Vec::new(),
     })
 }

@@ -11,8 +11,8 @@ pub mod relight;
 pub mod render;
 
 pub use export::{run_export, ExportJob};
-pub use relight::{relight, run_relight, RelightJob};
-pub use render::{run_render, RenderJob};
+pub use relight::{relight, run_relight, run_relight_with, RelightJob};
+pub use render::{run_render, run_render_with, RenderJob};
 
 use crate::export::solution::{self, SavedSolution};
 use crate::render::false_colour::Scale;
@@ -45,6 +45,15 @@ pub struct OutputReport {
     pub exposure: Option<f32>,
     /// The false-colour scale (W/m²), for `--false-colour`.
     pub scale: Option<Scale>,
+    /// How an image was shaded (`gather`, `gouraud`); none for a mesh or false colour.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shading: Option<String>,
+    /// What a final-gather picture cost.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gather: Option<crate::render::gather::GatherStats>,
+    /// What a user should hear of (printed as `warning: …`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Loads a solution and, when asked, checks it belongs to the given scene.

@@ -1,12 +1,22 @@
 //! `radiosity render`: a saved solution to PNG (tone-mapped radiosity, or irradiance in false
-//! colour), Radiance HDR or OpenEXR (radiance, W/sr/m²: [`crate::export::image`]).
+//! colour), Radiance HDR or OpenEXR (radiance, W/sr/m²: [`crate::export::image`]), shaded by a
+//! final gather per pixel ([`crate::render::gather`]) or as the Gouraud preview.
+//!
+//! The gather casts rays into the solution's mesh, so it builds the intersector a solve would
+//! (`auto`), after pairing the back twins the file does not keep ([`crate::mesh::Mesh::pair_twins`]);
+//! the sky of a daylit solve is rebuilt from the settings the file keeps.
 
 use super::{bounds, load_checked, OutputReport, SceneCheck};
 use crate::export::image::{self as image_out, ImageKind};
 use crate::export::solution::SavedSolution;
 use crate::export::write_atomic;
+use crate::intersect::select::{self, IntersectorKind};
+use crate::progress::Progress;
 use crate::render::false_colour;
-use crate::render::{self, ViewSettings};
+use crate::render::gather::{render_gather, GatherStats};
+use crate::render::{self, Camera, LinearImage, Shading, ShadingSettings, ViewSettings};
+use crate::sky::{Sky, SkySpec};
+use crate::solve::final_gather::{PointGather, Relit};
 use crate::Error;
 use std::path::PathBuf;
 
@@ -18,8 +28,11 @@ pub struct RenderJob {
     /// `.png`, `.hdr` or `.exr` (the last two in radiance, B/π).
     pub out: PathBuf,
     pub view: ViewSettings,
-    /// Irradiance in false colour with a legend (PNG only).
+    /// Irradiance in false colour with a legend (PNG only; drawn from the patches, whatever
+    /// the shading).
     pub false_colour: bool,
+    /// Final gather or Gouraud (`--shading`, `--pixel-rays`, `--seed`).
+    pub shading: ShadingSettings,
 }
 
 /// The image format from `--out`, after checking the view and that false colour goes to PNG.
@@ -36,32 +49,91 @@ pub(crate) fn check_render_options(job: &RenderJob) -> Result<ImageKind, Error> 
         ));
     }
     job.view.check()?;
+    job.shading.check()?;
     Ok(kind)
 }
 
 /// `radiosity render`.
 pub fn run_render(job: &RenderJob) -> Result<OutputReport, Error> {
-    let kind = check_render_options(job)?;
-    let sol = load_checked(&job.solution, job.check.as_ref())?;
-    render_loaded(&sol, kind, job)
+    run_render_with(job, &Progress::hidden())
 }
 
-/// Renders a loaded (or relit) solution as `job` says.
+/// [`run_render`] with a progress bar while the gather runs.
+pub fn run_render_with(job: &RenderJob, progress: &Progress) -> Result<OutputReport, Error> {
+    let kind = check_render_options(job)?;
+    let sol = load_checked(&job.solution, job.check.as_ref())?;
+    render_loaded(&sol, kind, job, None, progress)
+}
+
+/// The sky a saved solution was solved under, rebuilt from the settings it keeps
+/// (`settings.solve.sky`, issue 14); `Err` says why it cannot be (a file from a version whose
+/// sky settings this one does not read).
+pub fn saved_sky(sol: &SavedSolution) -> Result<Option<Sky>, String> {
+    let spec = match sol.meta.settings.get("solve").and_then(|s| s.get("sky")) {
+        None | Some(serde_json::Value::Null) => return Ok(None),
+        Some(v) => serde_json::from_value::<SkySpec>(v.clone()).map_err(|e| e.to_string())?,
+    };
+    Sky::new(&spec).map(Some).map_err(|e| e.to_string())
+}
+
+/// The final-gather picture of a loaded (or relit) solution, and what it cost; the warnings a
+/// user should hear of (a sky that could not be rebuilt).
+pub(crate) fn gather_image(
+    sol: &SavedSolution,
+    cam: &Camera,
+    job: &RenderJob,
+    relit: Option<Relit>,
+    progress: &Progress,
+    warnings: &mut Vec<String>,
+) -> Result<(LinearImage, GatherStats), Error> {
+    let mut mesh = sol.mesh.clone();
+    mesh.pair_twins();
+    let (isect, _) = select::select(&mesh, IntersectorKind::Auto)?;
+    let materials: Vec<_> = sol.meta.materials.iter().map(|m| m.material()).collect();
+    let sky = saved_sky(sol).unwrap_or_else(|e| {
+        warnings.push(format!(
+            "the solution's sky could not be rebuilt ({e}): the gathered picture shows no sky or sun light arriving directly (the solution's own light, which includes the sky's, is still gathered)"
+        ));
+        None
+    });
+    let gather = PointGather::new(&mesh, &materials, &isect, &sol.b, sky.as_ref(), relit);
+    let rows = progress.start_count("rendering", u64::from(job.view.image.height));
+    let out = render_gather(&gather, cam, &job.view.image, &job.shading, &rows);
+    progress.finish();
+    Ok(out)
+}
+
+/// Renders a loaded (or relit: `relit` says its lights) solution as `job` says.
 pub(crate) fn render_loaded(
     sol: &SavedSolution,
     kind: ImageKind,
     job: &RenderJob,
+    relit: Option<Relit>,
+    progress: &Progress,
 ) -> Result<OutputReport, Error> {
     let (lo, hi) = bounds(sol);
     let cam = job.view.camera_for(lo, hi);
     let mut exposure = None;
     let mut scale = None;
+    let mut shading = None;
+    let mut gathered = None;
+    let mut warnings = Vec::new();
     if job.false_colour {
         let (img, s) = false_colour::render(&sol.mesh, &sol.irradiance(), &cam, &job.view.image);
         scale = Some(s);
         write_atomic(&job.out, |w| image_out::write_png(w, &img))?;
     } else {
-        let lin = render::render_linear(&sol.mesh, &sol.vertex_b, &cam, &job.view.image);
+        let lin = match job.shading.shading {
+            Shading::Gouraud => {
+                render::render_linear(&sol.mesh, &sol.vertex_b, &cam, &job.view.image)
+            }
+            Shading::Gather => {
+                let (lin, stats) = gather_image(sol, &cam, job, relit, progress, &mut warnings)?;
+                gathered = Some(stats);
+                lin
+            }
+        };
+        shading = Some(job.shading.shading.name().to_string());
         match kind {
             ImageKind::Png => {
                 let (img, e) = render::tone_map(&lin, job.view.image.exposure);
@@ -81,5 +153,8 @@ pub(crate) fn render_loaded(
         vertices: sol.mesh.vertices.len(),
         exposure,
         scale,
+        shading,
+        gather: gathered,
+        warnings,
     })
 }

@@ -76,6 +76,8 @@ use glam::Vec3;
 use rand::seq::SliceRandom;
 use rand::Rng;
 use rayon::prelude::*;
+use std::borrow::Cow;
+use std::sync::OnceLock;
 use std::time::Instant;
 
 /// The "shot number" the gather's random numbers are drawn under (never a real shot's).
@@ -107,8 +109,10 @@ pub struct GatherStats {
 struct Ctx<'a, I> {
     mesh: &'a Mesh,
     isect: &'a I,
-    e: &'a [[f64; 3]],
-    rho: &'a [[f64; 3]],
+    /// Emitted radiosity and reflectance per patch: borrowed by the solver's gather, owned by a
+    /// [`PointGather`] (which derives them from the materials itself).
+    e: Cow<'a, [[f64; 3]]>,
+    rho: Cow<'a, [[f64; 3]]>,
     /// The shooting's radiosity, and per light channel.
     b: &'a [[f64; 3]],
     channels: &'a [LightChannel],
@@ -130,6 +134,9 @@ struct Ctx<'a, I> {
     /// The sky's and the sun's per-light channels, when kept.
     sky_channel: Option<usize>,
     sun_channel: Option<usize>,
+    /// Weights of the sky's and the sun's light (1; a relit picture's, [`Relit`]).
+    sky_weight: f64,
+    sun_weight: f64,
 }
 
 /// A hemisphere ray meeting a side closer than this many times the side's size (√A) takes the
@@ -176,8 +183,8 @@ struct Reflected {
 
 /// The solution a gather reads.
 struct Inputs<'a> {
-    e: &'a [[f64; 3]],
-    rho: &'a [[f64; 3]],
+    e: Cow<'a, [[f64; 3]]>,
+    rho: Cow<'a, [[f64; 3]]>,
     b: &'a [[f64; 3]],
     channels: &'a [LightChannel],
     group: Option<&'a [u32]>,
@@ -235,6 +242,8 @@ impl<'a, I: Intersector> Ctx<'a, I> {
             },
             sky_channel: channel(super::lights::SKY_CHANNEL),
             sun_channel: channel(super::lights::SUN_CHANNEL),
+            sky_weight: 1.0,
+            sun_weight: 1.0,
         }
     }
 }
@@ -258,8 +267,8 @@ pub fn sensor_irradiance<I: Intersector>(
     let e: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).emission()).collect();
     let rho: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).rho).collect();
     let inputs = Inputs {
-        e: &e,
-        rho: &rho,
+        e: Cow::Owned(e),
+        rho: Cow::Owned(rho),
         b,
         channels: &[],
         group: None,
@@ -272,8 +281,17 @@ pub fn sensor_irradiance<I: Intersector>(
             let mut rng = rng_for(seed, SENSOR_STREAM, k as u64);
             let n = n.normalize_or_zero();
             let at = |_: f32, _: f32| x;
-            ctx.gather_at(NO_PATCH, &at, n, ctx.eps_floor, [1.0; 3], &mut rng)
-                .h
+            ctx.gather_at(
+                NO_PATCH,
+                &at,
+                n,
+                ctx.eps_floor,
+                [1.0; 3],
+                ctx.rays,
+                true,
+                &mut rng,
+            )
+            .h
         })
         .collect()
 }
@@ -370,12 +388,25 @@ impl<I: Intersector> Ctx<'_, I> {
         let points = PatchPoints::new(self.mesh, i);
         let mut rng = rng_for(self.seed, GATHER_STREAM, i as u64);
         let at = |u: f32, v: f32| points.at(u, v);
-        self.gather_at(i, &at, patch.normal, eps, self.rho[i], &mut rng)
+        self.gather_at(
+            i,
+            &at,
+            patch.normal,
+            eps,
+            self.rho[i],
+            self.rays,
+            true,
+            &mut rng,
+        )
     }
 
     /// The gather at the points `at(u, v)` of the unit square's map (a patch's, or one
     /// sensor's point) facing `n`, rays leaving patch `i`'s surface ([`NO_PATCH`] for a
-    /// sensor in the air); `rho` weighs the channels of the variance.
+    /// sensor in the air); `rho` weighs the channels of the variance; `rays` in all (half to
+    /// the emitters, a quarter to the sun when there is one, the rest over the hemisphere).
+    /// `lights` false sends the emitters' half over the hemisphere too: for points no emitter
+    /// faces, which a hemisphere ray then cannot meet on its emitting side either.
+    #[allow(clippy::too_many_arguments)]
     fn gather_at<R: Rng>(
         &self,
         i: usize,
@@ -383,6 +414,8 @@ impl<I: Intersector> Ctx<'_, I> {
         n: Vec3,
         eps: f32,
         rho: [f64; 3],
+        rays_wanted: usize,
+        lights: bool,
         rng: &mut R,
     ) -> Gathered {
         let mesh = self.mesh;
@@ -392,18 +425,19 @@ impl<I: Intersector> Ctx<'_, I> {
         let mut var = 0.0;
         let mut rays = 0u64;
         // Half the rays to the emitters (when there are any), half over the hemisphere.
-        let n_direct = if self.emitters.is_empty() {
+        let n_direct = if self.emitters.is_empty() || !lights {
             0
         } else {
-            (self.rays / 2).max(1)
+            (rays_wanted / 2).max(1)
         };
         let sun = self.sky.and_then(Sky::sun);
         let n_sun = if sun.is_some() {
-            (self.rays / 4).max(1)
+            (rays_wanted / 4).max(1)
         } else {
             0
         };
-        let grid = PolarGrid::for_samples(self.rays.saturating_sub(n_direct + n_sun).max(2) as f64);
+        let grid =
+            PolarGrid::for_samples(rays_wanted.saturating_sub(n_direct + n_sun).max(2) as f64);
         let (nl, nc) = (n_direct as f64, grid.len() as f64);
 
         // Direct: emitters by power, points on them uniform, shadow rays.
@@ -543,7 +577,8 @@ impl<I: Intersector> Ctx<'_, I> {
     /// left out (sampled on its own).
     fn sky_exitance(&self, dir: Vec3) -> [f64; 3] {
         self.sky.map_or([0.0; 3], |s| {
-            s.radiance(dir).map(|l| l * std::f64::consts::PI)
+            s.radiance(dir)
+                .map(|l| l * std::f64::consts::PI * self.sky_weight)
         })
     }
 
@@ -575,7 +610,7 @@ impl<I: Intersector> Ctx<'_, I> {
         if seen.hit.is_some() {
             return [0.0; 3];
         }
-        let w = seen.through * Sun::solid_angle() * f64::from(cos);
+        let w = seen.through * Sun::solid_angle() * f64::from(cos) * self.sun_weight;
         sun.radiance().map(|l| l * w)
     }
 
@@ -848,8 +883,8 @@ pub fn apply<I: Intersector>(
         .filter(|&i| !faces_void(i) && scalar(&rho[i]) > 0.0)
         .collect();
     let inputs = Inputs {
-        e: &e,
-        rho: &rho,
+        e: Cow::Borrowed(&e),
+        rho: Cow::Borrowed(&rho),
         b: &sol.b,
         channels: &sol.channels,
         group: group.filter(|_| !sol.channels.is_empty()),
@@ -954,5 +989,204 @@ pub fn apply<I: Intersector>(
         };
         sol.stats.trace.push(p);
         on_trace(&p);
+    }
+}
+
+/// The final gather at points a camera sees (issue 15, `--shading gather`): the solution as
+/// the cache of a per-pixel gather, after Reichert (*A Two-Pass Radiosity Method Driven by
+/// Lights and Viewer Position*, MSc thesis, Cornell 1992) and Lischinski, Tampieri &
+/// Greenberg (SIGGRAPH 1993): direct light from every emitter (and the sun) sampled with
+/// shadow rays at the point itself, so shadows are as sharp as the geometry makes them, not as
+/// the mesh does; indirect light from cosine-weighted rays that take the solved B of the side
+/// they meet, with the near-hit rule of the solver's own gather ([`NEAR`]) so that corners and
+/// narrow gaps are not blotchy with the constant B of the patches beside them.
+///
+/// It is the solver's gather ([`apply`], [`sensor_irradiance`]) applied to the points of one
+/// patch seen through one pixel: the same light sampling, multiple importance sampling, sky,
+/// sun and glazing. Built once per image; shared by every thread.
+pub struct PointGather<'a, I> {
+    ctx: Ctx<'a, I>,
+    /// Per patch, once asked: whether any emitter faces it ([`PointGather::radiosity_at`]).
+    facing: Vec<OnceLock<bool>>,
+}
+
+/// Above this many emitting patches, every patch is taken as facing one (the test is O(emitters)
+/// per patch seen).
+const FACING_TEST_MAX: usize = 4096;
+
+/// What a ray from the camera met ([`PointGather::view`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ViewHit {
+    /// The side seen: the patch, or the back twin of a two-sided surface.
+    pub patch: usize,
+    /// Where the ray met it.
+    pub point: Vec3,
+}
+
+/// What a camera ray sees: the first side that faces it (backs of one-sided patches are passed
+/// through, as the Gouraud rasterizer culls them), the transmittance of the glazing before it
+/// and what the panes' sides reflect towards the camera (W/m², already weighed).
+#[derive(Clone, Copy, Debug)]
+pub struct ViewSeen {
+    pub hit: Option<ViewHit>,
+    pub through: f64,
+    pub panes: [f64; 3],
+    /// Rays cast.
+    pub rays: u64,
+}
+
+/// The lights of a relit solution (`radiosity relight`): each patch's emitted radiosity E
+/// times its light's weight, and the weights of the sky and the sun.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Relit {
+    pub emission: Vec<[f64; 3]>,
+    pub sky: f64,
+    pub sun: f64,
+}
+
+impl<'a, I: Intersector> PointGather<'a, I> {
+    /// The gather of the solution `b` (W/m² per patch of `mesh`) through `isect` (built over
+    /// `mesh`, whose sides say which patch a back hit goes to), lit by `sky` when it has one;
+    /// with `relit`, by the re-weighted lights that made `b`, so that the direct light, the
+    /// emitters seen and the B − E of the sides met all agree with it.
+    pub fn new(
+        mesh: &'a Mesh,
+        materials: &[Material],
+        isect: &'a I,
+        b: &'a [[f64; 3]],
+        sky: Option<&'a Sky>,
+        relit: Option<Relit>,
+    ) -> Self {
+        let mat = |i: usize| &materials[mesh.patches[i].material as usize];
+        let (e, sky_weight, sun_weight) = match relit {
+            Some(r) if r.emission.len() == mesh.patches.len() => (r.emission, r.sky, r.sun),
+            _ => (
+                (0..mesh.patches.len()).map(|i| mat(i).emission()).collect(),
+                1.0,
+                1.0,
+            ),
+        };
+        let rho: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).rho).collect();
+        let inputs = Inputs {
+            e: Cow::Owned(e),
+            rho: Cow::Owned(rho),
+            b,
+            channels: &[],
+            group: None,
+        };
+        let mut ctx = Ctx::new(mesh, materials, isect, inputs, 0, 4, sky);
+        ctx.sky_weight = sky_weight;
+        ctx.sun_weight = sun_weight;
+        PointGather {
+            ctx,
+            facing: (0..mesh.patches.len()).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// Whether some emitter could light `patch`: one with a corner in front of the patch's
+    /// plane while the patch has a corner in front of the emitter's (a planar emitter lights
+    /// its front only; a patch receives on its front only). When none does — a ceiling beside
+    /// its flush lamps — light samples could only miss, so the gather's rays all go over the
+    /// hemisphere instead: half the noise variance where the picture is lit indirectly alone.
+    fn lit_by_an_emitter(&self, patch: usize) -> bool {
+        let ctx = &self.ctx;
+        if ctx.emitters.len() > FACING_TEST_MAX {
+            return true;
+        }
+        let mesh = ctx.mesh;
+        let tol = ctx.eps_floor;
+        let corners = |i: usize| {
+            mesh.patch_indices(i)
+                .iter()
+                .map(|&v| mesh.vertices[v as usize])
+        };
+        let in_front = |i: usize, of: usize| {
+            let (n, c) = (mesh.patches[of].normal, mesh.patches[of].centre);
+            corners(i).any(|v| n.dot(v - c) > tol)
+        };
+        ctx.emitters
+            .iter()
+            .any(|&j| j != patch && in_front(j, patch) && in_front(patch, j))
+    }
+
+    /// What the ray from `org` along `dir` sees. The backs of one-sided patches are passed
+    /// through (a camera outside a closed room sees into it, as in the Gouraud image); glazing
+    /// is seen and seen through as by the gather's rays.
+    pub fn view(&self, org: Vec3, dir: Vec3) -> ViewSeen {
+        let ctx = &self.ctx;
+        let mut ray = Ray {
+            org,
+            dir,
+            tnear: 0.0,
+            tfar: f32::INFINITY,
+        };
+        let mut out = ViewSeen {
+            hit: None,
+            through: 1.0,
+            panes: [0.0; 3],
+            rays: 0,
+        };
+        for _ in 0..MAX_STEPS {
+            let seen = ctx.cast(NO_PATCH, ray, ctx.eps_floor);
+            out.rays += 1;
+            for q in 0..3 {
+                out.panes[q] += out.through * seen.panes[q];
+            }
+            out.through *= seen.through;
+            let Some(h) = seen.hit else {
+                return out;
+            };
+            if let Some(r) = ctx.mesh.receiver(h.patch, h.back) {
+                out.hit = Some(ViewHit {
+                    patch: r as usize,
+                    point: org + dir * h.t,
+                });
+                return out;
+            }
+            ray.tnear = h.t + (h.t * 1e-5).max(ctx.eps_floor);
+        }
+        out.through = 0.0;
+        out
+    }
+
+    /// The radiosity B = E + ρ·H (RGB, W/m²) leaving `patch` at the points `points` (on it,
+    /// seen through one pixel), H their mean irradiance gathered with about `rays` rays in
+    /// all: half shadow rays to the emitters, a quarter to the sun when there is one, the rest
+    /// cosine-weighted over the hemisphere (points, light samples and directions stratified
+    /// together, so the points of one pixel share one stratified gather). Returns B and the
+    /// rays cast. A side that reflects nothing is its emission alone, without a ray.
+    pub fn radiosity_at<R: Rng>(
+        &self,
+        patch: usize,
+        points: &[Vec3],
+        rays: usize,
+        rng: &mut R,
+    ) -> ([f64; 3], u64) {
+        let ctx = &self.ctx;
+        let (e, rho) = (ctx.e[patch], ctx.rho[patch]);
+        if points.is_empty() || scalar(&rho) <= 0.0 {
+            return (e, 0);
+        }
+        let p = &ctx.mesh.patches[patch];
+        let eps = (1e-4 * (p.area as f32).sqrt()).max(ctx.eps_floor);
+        let m = points.len();
+        let at = |u: f32, _: f32| points[((u * m as f32) as usize).min(m - 1)];
+        let lights = *self.facing[patch].get_or_init(|| self.lit_by_an_emitter(patch));
+        let g = ctx.gather_at(patch, &at, p.normal, eps, rho, rays.max(2), lights, rng);
+        let b = [0, 1, 2].map(|q| {
+            let v = e[q] + rho[q] * g.h[q];
+            if v.is_finite() {
+                v.max(0.0)
+            } else {
+                0.0
+            }
+        });
+        (b, g.rays)
+    }
+
+    /// What a camera ray that leaves the model sees: the sky's radiance as an exitance, π·L
+    /// (the unit of B), black without a sky; the sun's disc is left out.
+    pub fn sky_exitance(&self, dir: Vec3) -> [f64; 3] {
+        self.ctx.sky_exitance(dir)
     }
 }

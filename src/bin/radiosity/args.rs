@@ -6,9 +6,10 @@ use clap::Args;
 use glam::Vec3;
 use radiosity::intersect::select::IntersectorKind;
 use radiosity::mesh::MeshOptions;
+use radiosity::render::gather::DEFAULT_PIXEL_RAYS;
 use radiosity::render::view::{image_size, DEFAULT_SUPERSAMPLE};
 use radiosity::render::view_file::RadianceView;
-use radiosity::render::{CameraSpec, RenderOptions, ViewSettings};
+use radiosity::render::{CameraSpec, RenderOptions, Shading, ShadingSettings, ViewSettings};
 use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
 use radiosity::solve::lights::GroupBy;
@@ -323,6 +324,49 @@ impl ViewArgs {
                 exposure: self.exposure,
             },
         })
+    }
+}
+
+/// How a picture is shaded (`solve`, `render`, `relight`).
+#[derive(Args)]
+pub struct ShadingArgs {
+    /// gather: each pixel gathers its light with rays (direct light sampled with shadow rays,
+    /// so shadows are sharp whatever the patch size; indirect light from the solved radiosity);
+    /// gouraud: the solution's patches interpolated at their vertices, the fast preview
+    /// [default: gather for render and relight, gouraud for solve]
+    #[arg(long, value_enum)]
+    pub shading: Option<ShadingArg>,
+    /// --shading gather: rays gathered per anti-aliasing sample (half to the lights, the rest
+    /// over the hemisphere); --supersample sets the samples per pixel.
+    #[arg(long, default_value_t = DEFAULT_PIXEL_RAYS, value_name = "N")]
+    pub pixel_rays: usize,
+}
+
+impl ShadingArgs {
+    /// The settings, with the pixels' random numbers seeded by `seed`; `default` where
+    /// `--shading` is left out (the command's own).
+    pub fn settings(&self, seed: u64, default: Shading) -> ShadingSettings {
+        ShadingSettings {
+            shading: self.shading.map_or(default, Shading::from),
+            rays: self.pixel_rays,
+            seed,
+        }
+    }
+}
+
+/// `--shading`: see `radiosity::render::Shading`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum ShadingArg {
+    Gather,
+    Gouraud,
+}
+
+impl From<ShadingArg> for Shading {
+    fn from(s: ShadingArg) -> Shading {
+        match s {
+            ShadingArg::Gather => Shading::Gather,
+            ShadingArg::Gouraud => Shading::Gouraud,
+        }
     }
 }
 

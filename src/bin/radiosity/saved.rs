@@ -1,8 +1,10 @@
 //! The commands that act on a saved solution (`solve --save`): `render`, `export`, `relight`.
 
-use crate::args::{parse_weight, CheckArgs, ViewArgs};
+use crate::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs};
 use crate::outln;
 use clap::Args;
+use radiosity::progress::Progress;
+use radiosity::render::Shading;
 use radiosity::saved::{self, ExportJob, OutputReport, RelightJob, RenderJob};
 use std::path::PathBuf;
 
@@ -18,6 +20,12 @@ pub struct RenderArgs {
     check: CheckArgs,
     #[command(flatten)]
     view: ViewArgs,
+    #[command(flatten)]
+    shading: ShadingArgs,
+    /// Seed of the gathered picture's random numbers; the same seed gives the same image on
+    /// any thread count.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
     /// Irradiance in false colour on a log scale, with a legend in W/m² (PNG only).
     #[arg(long, alias = "false-color")]
     false_colour: bool,
@@ -37,6 +45,7 @@ impl RenderArgs {
             out: self.out.clone(),
             view: self.view.settings()?,
             false_colour: self.false_colour,
+            shading: self.shading.settings(self.seed, Shading::Gather),
         })
     }
 }
@@ -72,7 +81,9 @@ pub struct RelightArgs {
 }
 
 pub fn render(a: RenderArgs) -> Result<(), radiosity::Error> {
-    let r = saved::run_render(&a.job()?)?;
+    let progress = Progress::for_terminal(a.quiet || a.json);
+    let r = saved::run_render_with(&a.job()?, &progress)?;
+    drop(progress);
     print_report(&r, a.json, a.quiet);
     Ok(())
 }
@@ -82,7 +93,9 @@ pub fn relight(a: RelightArgs) -> Result<(), radiosity::Error> {
         render: a.render.job()?,
         weights: a.weights,
     };
-    let r = saved::run_relight(&job)?;
+    let progress = Progress::for_terminal(a.render.quiet || a.render.json);
+    let r = saved::run_relight_with(&job, &progress)?;
+    drop(progress);
     print_report(&r, a.render.json, a.render.quiet);
     Ok(())
 }
@@ -101,6 +114,9 @@ pub fn export(a: ExportArgs) -> Result<(), radiosity::Error> {
 
 /// The one-line report of `render`, `export` and `relight`, or its JSON.
 fn print_report(r: &OutputReport, json: bool, quiet: bool) {
+    for w in &r.warnings {
+        eprintln!("warning: {w}");
+    }
     if json {
         outln!("{}", serde_json::to_string_pretty(r).unwrap_or_default());
     } else if !quiet {
@@ -108,6 +124,14 @@ fn print_report(r: &OutputReport, json: bool, quiet: bool) {
             (Some(s), _) => format!(", irradiance {}–{} W/m² on a log scale", s.lo, s.hi),
             (None, Some(e)) => format!(", exposure {e:.4}"),
             (None, None) => ", radiance in W/sr/m² (radiosity/π)".to_string(),
+        };
+        let extra = match (&r.shading, &r.gather) {
+            (_, Some(g)) => format!(
+                "{extra}; final gather, {:.0} rays per pixel, {:.2} s",
+                g.rays_per_pixel, g.seconds
+            ),
+            (Some(s), None) => format!("{extra}; {s} shading"),
+            _ => extra,
         };
         outln!(
             "{}: {} of {} ({} patches, {} vertices){extra}",

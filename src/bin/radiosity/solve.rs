@@ -1,6 +1,6 @@
 //! `radiosity solve`.
 
-use crate::args::{source, LightGroupsArg, SceneArgs, SolverArgs, ViewArgs};
+use crate::args::{source, LightGroupsArg, SceneArgs, ShadingArgs, SolverArgs, ViewArgs};
 use crate::sky_args::SkyArgs;
 use crate::{interrupt_flag, outln};
 use clap::Args;
@@ -28,6 +28,8 @@ pub struct SolveArgs {
     reference: Option<PathBuf>,
     #[command(flatten)]
     view: ViewArgs,
+    #[command(flatten)]
+    shading: ShadingArgs,
     /// Print nothing but errors.
     #[arg(long, short)]
     quiet: bool,
@@ -67,6 +69,7 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
         sky: a.sky.spec().map_err(radiosity::Error::Invalid)?,
         ..a.solve_args.solve_settings()
     };
+    let solve_seed = solve.seed;
     let job = SolveJob {
         source: source(a.scene),
         settings: RunSettings {
@@ -88,6 +91,9 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
         grid_rays: a.sky.grid_rays,
         zenith: a.sky.zenith,
         north: a.sky.north,
+        shading: a
+            .shading
+            .settings(solve_seed, radiosity::render::Shading::Gouraud),
     };
     let quiet = a.quiet || a.json;
     let progress = Progress::for_terminal(quiet);

@@ -1,0 +1,251 @@
+//! The final-gather renderer (issue 15, `--shading gather`): each pixel's visible points
+//! gather their light with rays, the radiosity solution serving as the cache of the indirect
+//! light — the two-pass "radiosity as a cache" pictures of Reichert (*A Two-Pass Radiosity
+//! Method Driven by Lights and Viewer Position*, MSc thesis, Cornell 1992) and Lischinski,
+//! Tampieri & Greenberg (*Combining Hierarchical Radiosity and Discontinuity Meshing*,
+//! SIGGRAPH 1993, Sec. 5).
+//!
+//! **Why.** The Gouraud image ([`super::render_linear`]) shows the solution as it is: one B per
+//! patch, averaged to the vertices and interpolated. A shadow is then as sharp as the mesh — a
+//! 0.5 m patch half in shadow is grey over its whole extent — and the light's edge bleeds
+//! along every patch boundary. Here the mesh only supplies the light that has bounced:
+//!
+//! - **Visible point**: a ray through the pixel (the backs of one-sided patches passed through,
+//!   as the rasterizer culls them; glazing seen and seen through).
+//! - **Direct light** from each emitter and the sun, sampled explicitly with shadow rays *at
+//!   that point* ([`PointGather::radiosity_at`], the solver's own light sampling and MIS): shadows
+//!   as sharp as the geometry makes them, whatever the patch size.
+//! - **Indirect light**: cosine-weighted rays that take the solved B − E of the side they meet,
+//!   or follow it on when it is nearer than that side's size (the near-hit rule of the
+//!   solver's gather, `final_gather::NEAR`), so corners are not blotchy.
+//! - B = E + ρ·H per channel, in f64; an emitter seen shows its emission. Rays that leave the
+//!   model see the sky (as an exitance π·L, the unit of B) when the solve had one, else black.
+//!
+//! **Anti-aliasing**: s×s jittered samples per pixel (`--supersample`, stratified over the
+//! pixel). The samples that meet the same side are gathered together: their points share one
+//! stratified gather of s²·`--pixel-rays` rays (points, light samples and hemisphere cells
+//! paired in random order), which is less noisy than s² independent gathers of the same rays.
+//!
+//! **Deterministic for a seed**: a pixel's random numbers come from (seed, [`RENDER_STREAM`],
+//! pixel index) alone; rows are shaded in parallel, each into its own slice, so the image does
+//! not depend on the thread count or the scheduling.
+//!
+//! The image is the same linear radiosity (W/m² per channel) as the Gouraud path's, so
+//! exposure, tone mapping and the image writers treat the two alike.
+
+use super::{Camera, LinearImage, RenderOptions};
+use crate::intersect::Intersector;
+use crate::progress::Counter;
+use crate::settings::Invalid;
+use crate::solve::final_gather::PointGather;
+use crate::solve::rng_for;
+use glam::Vec3;
+use rand::Rng;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// The random-number stream of the pictures' pixels (never a shot's, nor a gather's).
+pub const RENDER_STREAM: u64 = u64::MAX - 4;
+
+/// Rays gathered per anti-aliasing sample by default (`--pixel-rays`): with the default 3×3
+/// samples, 144 per pixel (README, "Final-gather pictures", for the measurements behind it).
+pub const DEFAULT_PIXEL_RAYS: usize = 16;
+
+/// Most rays per sample `--pixel-rays` takes.
+pub const MAX_PIXEL_RAYS: usize = 65_536;
+
+/// How a picture is shaded (`--shading`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Shading {
+    /// The solution's B per patch, averaged to the welded vertices and Gouraud-interpolated
+    /// ([`super::render_linear`]): the fast preview, as the paper shows its images; the
+    /// library's default and `solve`'s (its picture is a by-product of the solve).
+    #[default]
+    Gouraud,
+    /// A final gather per pixel ([`render_gather`]): `render`'s and `relight`'s default.
+    Gather,
+}
+
+impl Shading {
+    /// The flag's spelling.
+    pub fn name(self) -> &'static str {
+        match self {
+            Shading::Gouraud => "gouraud",
+            Shading::Gather => "gather",
+        }
+    }
+}
+
+/// How a picture is shaded, and with how many rays.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ShadingSettings {
+    pub shading: Shading,
+    /// Rays gathered per anti-aliasing sample (`--pixel-rays`): half to the lights, a quarter
+    /// to the sun when there is one, the rest over the hemisphere.
+    pub rays: usize,
+    /// Seed of the pixels' random numbers.
+    pub seed: u64,
+}
+
+impl Default for ShadingSettings {
+    fn default() -> Self {
+        ShadingSettings {
+            shading: Shading::default(),
+            rays: DEFAULT_PIXEL_RAYS,
+            seed: 1,
+        }
+    }
+}
+
+impl ShadingSettings {
+    /// Refuses a ray count the renderer cannot use (one line naming the flag).
+    pub fn check(&self) -> Result<(), Invalid> {
+        if !(1..=MAX_PIXEL_RAYS).contains(&self.rays) {
+            return Invalid::err(format!(
+                "--pixel-rays must be between 1 and {MAX_PIXEL_RAYS}, got {}",
+                self.rays
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What a gathered picture cost.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct GatherStats {
+    /// Anti-aliasing samples (camera rays) in all.
+    pub samples: u64,
+    /// Rays cast in all: camera rays, shadow rays, hemisphere rays and near hits followed.
+    pub rays: u64,
+    /// Rays per pixel, on average.
+    pub rays_per_pixel: f64,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+}
+
+/// The primary ray through the image point (x, y), in pixels from the top left corner of a
+/// `width`×`height` picture: [`Camera::ray`], the rasterizer's own projection (perspective or
+/// parallel, shifted, from the fore clipping plane), so the gathered and the Gouraud pictures
+/// of one camera line up pixel for pixel; `None` for a camera that is not finite.
+fn primary_ray(camera: &Camera, x: f32, y: f32, width: f32, height: f32) -> Option<(Vec3, Vec3)> {
+    let (org, dir) = camera.ray(x / width, y / height);
+    (org.is_finite() && dir.is_finite() && dir != Vec3::ZERO).then_some((org, dir))
+}
+
+/// `sum` += `w`·`v`, per channel.
+fn add(sum: &mut [f64; 3], v: [f64; 3], w: f64) {
+    for (s, v) in sum.iter_mut().zip(v) {
+        *s += w * v;
+    }
+}
+
+/// The samples of one pixel that met one side: its points and their weight (the glazing's
+/// transmittance before them, summed).
+struct Group {
+    patch: usize,
+    points: Vec<Vec3>,
+    weight: f64,
+}
+
+/// Renders the view of `camera` by a final gather per pixel through `gather` (see the module
+/// notes): `opts.supersample`² jittered samples per pixel, `settings.rays` rays gathered per
+/// sample, reproducible for `settings.seed`. `rows` moves on by one per finished row. A zero
+/// width or height gives an image without pixels.
+pub fn render_gather<I: Intersector>(
+    gather: &PointGather<I>,
+    camera: &Camera,
+    opts: &RenderOptions,
+    settings: &ShadingSettings,
+    rows: &Counter,
+) -> (LinearImage, GatherStats) {
+    let t0 = Instant::now();
+    let (width, height) = (opts.width as usize, opts.height as usize);
+    let mut pixels = vec![[0.0f32; 3]; width.saturating_mul(height)];
+    let mut stats = GatherStats::default();
+    if pixels.is_empty() {
+        return (
+            LinearImage {
+                width: opts.width,
+                height: opts.height,
+                pixels,
+            },
+            stats,
+        );
+    }
+    let s = opts.supersample.clamp(1, 16) as usize;
+    let (fw, fh) = (opts.width as f32, opts.height as f32);
+    let rays = settings.rays.clamp(1, MAX_PIXEL_RAYS);
+    let counts: Vec<u64> = pixels
+        .par_chunks_mut(width)
+        .enumerate()
+        .map(|(y, row)| {
+            let mut groups: Vec<Group> = Vec::new();
+            let mut cast = 0u64;
+            for (x, px) in row.iter_mut().enumerate() {
+                let index = (y * width + x) as u64;
+                let mut rng = rng_for(settings.seed, RENDER_STREAM, index);
+                groups.clear();
+                let mut sum = [0.0f64; 3];
+                for k in 0..s * s {
+                    let (a, b) = ((k % s) as f32, (k / s) as f32);
+                    let (ja, jb) = (rng.gen::<f32>(), rng.gen::<f32>());
+                    let fx = x as f32 + (a + ja) / s as f32;
+                    let fy = y as f32 + (b + jb) / s as f32;
+                    let Some((org, dir)) = primary_ray(camera, fx, fy, fw, fh) else {
+                        continue;
+                    };
+                    let seen = gather.view(org, dir);
+                    cast += seen.rays;
+                    add(&mut sum, seen.panes, 1.0);
+                    match seen.hit {
+                        Some(h) => match groups.iter_mut().find(|g| g.patch == h.patch) {
+                            Some(g) => {
+                                g.points.push(h.point);
+                                g.weight += seen.through;
+                            }
+                            None => groups.push(Group {
+                                patch: h.patch,
+                                points: vec![h.point],
+                                weight: seen.through,
+                            }),
+                        },
+                        None => {
+                            add(&mut sum, gather.sky_exitance(dir), seen.through);
+                        }
+                    }
+                }
+                for g in &groups {
+                    let (b, n) =
+                        gather.radiosity_at(g.patch, &g.points, rays * g.points.len(), &mut rng);
+                    cast += n;
+                    add(&mut sum, b, g.weight);
+                }
+                *px = sum.map(|v| {
+                    let v = (v / (s * s) as f64) as f32;
+                    if v.is_finite() {
+                        v.max(0.0)
+                    } else {
+                        0.0
+                    }
+                });
+            }
+            rows.inc(1);
+            cast
+        })
+        .collect();
+    stats.samples = (width * height * s * s) as u64;
+    stats.rays = counts.iter().sum();
+    stats.rays_per_pixel = stats.rays as f64 / (width * height) as f64;
+    stats.seconds = t0.elapsed().as_secs_f64();
+    (
+        LinearImage {
+            width: opts.width,
+            height: opts.height,
+            pixels,
+        },
+        stats,
+    )
+}
