@@ -392,11 +392,16 @@ impl Summary {
         line += &format!(" in {:.2} s", stats.seconds);
         if let Some(t) = &stats.error_target {
             line += &format!(
-                "; error target {:.2} % {} after {} pass{} (estimate {:.2} %)",
+                "; error target {:.2} % {} after {} pass{}{} (estimate {:.2} %)",
                 100.0 * t.target,
                 if t.reached { "reached" } else { "NOT reached" },
                 t.passes,
                 if t.passes == 1 { "" } else { "es" },
+                match t.regathers {
+                    0 => String::new(),
+                    1 => " and 1 gather round".into(),
+                    k => format!(" and {k} gather rounds"),
+                },
                 100.0 * t.estimate
             );
             if t.gave_up {

@@ -107,10 +107,11 @@ pub fn shoot_with<I: Intersector>(
             b: sol.b.clone(),
             channels: sol.channels.clone(),
             parts,
+            gathers: None,
         }));
     }
     if let Some((isect, shooting)) = gather {
-        final_gather::apply(
+        let gathers = final_gather::apply(
             mesh,
             materials,
             isect,
@@ -121,8 +122,13 @@ pub fn shoot_with<I: Intersector>(
             sky.as_ref(),
             hooks.reference.as_deref().map(Vec::as_slice),
             &mut sol,
+            None,
             &mut on_trace,
         );
+        // An error target may add gather rounds to these (`passes`).
+        if let Some(shot) = sol.shooting.as_mut() {
+            shot.gathers = Some(gathers);
+        }
     }
     Ok(sol)
 }

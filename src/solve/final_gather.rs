@@ -84,6 +84,9 @@ use std::time::Instant;
 pub const GATHER_STREAM: u64 = u64::MAX - 1;
 /// The stream of the sensors' gathers.
 pub const SENSOR_STREAM: u64 = u64::MAX - 3;
+/// Re-gather round k draws under stream `GATHER_STREAM − k·REGATHER_STREAMS` (far from every
+/// other stream: shots count up from 0, the sensors' and pictures' are `u64::MAX − 3, − 4`).
+const REGATHER_STREAMS: u64 = 1 << 32;
 
 /// What the final gather did (`summary.json`: `final_gather`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -297,6 +300,7 @@ pub fn sensor_irradiance<I: Intersector>(
 }
 
 /// One patch's gather: irradiance H (RGB), per channel, the scalar variance of ρ·H's mean.
+#[derive(Clone, Debug)]
 struct Gathered {
     h: [f64; 3],
     ch: Vec<[f64; 3]>,
@@ -382,22 +386,16 @@ impl<I: Intersector> Ctx<'_, I> {
         out
     }
 
-    fn gather(&self, i: usize) -> Gathered {
+    /// Patch `i`'s gather of `rays` rays; `round` 0 is the first, later rounds
+    /// ([`Gathers::plan`]) draw independent random numbers to be pooled with it.
+    fn gather(&self, i: usize, rays: usize, round: u64) -> Gathered {
         let patch = &self.mesh.patches[i];
         let eps = (1e-4 * (patch.area as f32).sqrt()).max(self.eps_floor);
         let points = PatchPoints::new(self.mesh, i);
-        let mut rng = rng_for(self.seed, GATHER_STREAM, i as u64);
+        let stream = GATHER_STREAM.wrapping_sub(REGATHER_STREAMS * round);
+        let mut rng = rng_for(self.seed, stream, i as u64);
         let at = |u: f32, v: f32| points.at(u, v);
-        self.gather_at(
-            i,
-            &at,
-            patch.normal,
-            eps,
-            self.rho[i],
-            self.rays,
-            true,
-            &mut rng,
-        )
+        self.gather_at(i, &at, patch.normal, eps, self.rho[i], rays, true, &mut rng)
     }
 
     /// The gather at the points `at(u, v)` of the unit square's map (a patch's, or one
@@ -841,9 +839,156 @@ pub struct Shooting {
     pub energy_per_ray: f64,
 }
 
+/// The gathers [`apply`] made, per gathered patch, and what the error estimate after them was
+/// made of: kept so that a further round can add rays where they pay most and pool them with
+/// these ([`Gathers::plan`], used by `solve --error`, `passes`).
+#[derive(Clone, Debug, Default)]
+pub struct Gathers {
+    /// The gathered patches, and their pooled gathers.
+    todo: Vec<usize>,
+    got: Vec<Gathered>,
+    /// Rays asked of each so far (the gather's sample count; near hits followed cost more).
+    asked: Vec<usize>,
+    /// Per gathered patch, the error model after the last round.
+    model: Vec<PatchModel>,
+    /// The estimate's relative errors of the patches not gathered, summed, and how many
+    /// patches the estimate averages over.
+    fixed: f64,
+    count: usize,
+    /// Rounds so far, and their wall-clock seconds.
+    rounds: u64,
+    seconds: f64,
+}
+
+/// One gathered patch's error model: the shooting's variance and the gather's (of ρ·H's mean,
+/// W²/m⁴), whether the shooting was rejected as biased, the light still owed, and B's
+/// estimate (the relative error's denominator).
+#[derive(Clone, Copy, Debug)]
+struct PatchModel {
+    var_s: f64,
+    var_g: f64,
+    biased: bool,
+    missing: f64,
+    b_true: f64,
+}
+
+impl PatchModel {
+    /// The estimate's relative error of this patch with the gather's rays multiplied by `k`
+    /// (the gather's variance falls as 1/k: independent rounds pooled by their rays).
+    fn relative(&self, k: f64) -> f64 {
+        if self.b_true <= 0.0 {
+            return 0.0;
+        }
+        let var_g = self.var_g / k;
+        let floor = f64::MIN_POSITIVE;
+        let sigma = if self.biased {
+            var_g.sqrt()
+        } else {
+            (1.0 / (1.0 / (self.var_s + floor) + 1.0 / (var_g + floor))).sqrt()
+        };
+        estimate::combine(self.missing, sigma) / self.b_true
+    }
+}
+
+/// A further gather round ([`Gathers::plan`]): rays to add per patch (indexed by patch id),
+/// how many in all, and the estimate they are predicted to give.
+#[derive(Clone, Debug)]
+pub struct RegatherPlan {
+    pub extra: Vec<usize>,
+    pub asked: u64,
+    /// Rays the round is expected to cast (asked × the rays per asked ray measured so far).
+    pub rays: f64,
+    pub predicted: f64,
+}
+
+impl Gathers {
+    /// Rays cast by every round so far.
+    pub fn rays(&self) -> u64 {
+        self.got.iter().map(|g| g.rays).sum()
+    }
+
+    /// Where to add gather rays so that the estimate (the mean relative error over the
+    /// patches, [`estimate::from_errors`]) falls to `goal`, as cheaply as the model knows how.
+    ///
+    /// With its gather's rays multiplied by k_i, patch i's relative error e_i falls as
+    /// e_i/√k_i where the gather dominates it. Minimising Σ e_i/√k_i for a given total of rays
+    /// Σ n_i k_i (Lagrange) gives n_i k_i ∝ (e_i·√n_i)^(2/3): rays go where the error is, as
+    /// the cube root of its square, never fewer than a patch has. The multiplier is found by
+    /// bisection on the model's prediction ([`PatchModel::relative`], which also keeps what
+    /// rays cannot remove: the shooting's weight, the light still owed). `None` when even
+    /// `max_rays` per patch would not reach `goal`, or there is nothing to gather.
+    pub fn plan(&self, np: usize, goal: f64, max_rays: usize) -> Option<RegatherPlan> {
+        if self.todo.is_empty() || self.count == 0 {
+            return None;
+        }
+        let n = self.count as f64;
+        let want: Vec<f64> = self
+            .model
+            .iter()
+            .zip(&self.asked)
+            .map(|(m, &a)| (m.relative(1.0) * (a as f64).sqrt()).powf(2.0 / 3.0))
+            .collect();
+        let rays_at = |lambda: f64| -> Vec<usize> {
+            want.iter()
+                .zip(&self.asked)
+                .map(|(&w, &a)| ((lambda * w).ceil() as usize).clamp(a, max_rays.max(a)))
+                .collect()
+        };
+        let predict = |total: &[usize]| -> f64 {
+            let sum: f64 = self
+                .model
+                .iter()
+                .zip(total.iter().zip(&self.asked))
+                .map(|(m, (&t, &a))| m.relative(t as f64 / a.max(1) as f64))
+                .sum();
+            (self.fixed + sum) / n
+        };
+        let top = want.iter().cloned().fold(0.0, f64::max);
+        if top <= 0.0 || predict(&rays_at(f64::INFINITY)) > goal {
+            return None;
+        }
+        // λ so large every patch is at the cap meets the goal; halve the bracket 60 times.
+        let (mut lo, mut hi) = (0.0, max_rays as f64 / top.clamp(f64::MIN_POSITIVE, 1.0));
+        while predict(&rays_at(hi)) > goal {
+            hi *= 2.0;
+        }
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if predict(&rays_at(mid)) <= goal {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let total = rays_at(hi);
+        let mut extra = vec![0usize; np];
+        for (k, (&t, &a)) in total.iter().zip(&self.asked).enumerate() {
+            extra[self.todo[k]] = t - a;
+        }
+        let asked: u64 = extra.iter().map(|&x| x as u64).sum();
+        let asked_so_far: u64 = self.asked.iter().map(|&a| a as u64).sum();
+        let per_ray = self.rays() as f64 / asked_so_far.max(1) as f64;
+        Some(RegatherPlan {
+            extra,
+            asked,
+            rays: asked as f64 * per_ray,
+            predicted: predict(&total),
+        })
+    }
+}
+
+/// A further round for [`apply`]: the gathers so far, and the rays to add per patch.
+pub struct Regather<'a> {
+    pub prior: Gathers,
+    pub extra: &'a [usize],
+}
+
 /// Gathers the patches that need it (see the module notes) and rewrites `sol.b` and
 /// `sol.channels` with the combined estimates; records what it did in `sol.stats` and appends a
 /// trace point with the error estimate after the gather (and the error against `reference`).
+/// With `more`, `sol` must be the shooting result the prior gathers were made on: the patches
+/// given extra rays gather them afresh (independent random numbers), pooled with what they
+/// had by rays; the others keep theirs. Returns the gathers, for a further round.
 #[allow(clippy::too_many_arguments)]
 pub fn apply<I: Intersector>(
     mesh: &Mesh,
@@ -856,8 +1001,9 @@ pub fn apply<I: Intersector>(
     sky: Option<&Sky>,
     reference: Option<&[[f64; 3]]>,
     sol: &mut Solution,
+    more: Option<Regather>,
     on_trace: &mut impl FnMut(&TracePoint),
-) {
+) -> Gathers {
     let t0 = Instant::now();
     let np = mesh.patches.len();
     let mat = |i: usize| &materials[mesh.patches[i].material as usize];
@@ -879,9 +1025,6 @@ pub fn apply<I: Intersector>(
             other > 0.0 && reflected(&sol.b, i) <= estimate::DARK_SIDE * other
         })
     };
-    let todo: Vec<usize> = (0..np)
-        .filter(|&i| !faces_void(i) && scalar(&rho[i]) > 0.0)
-        .collect();
     let inputs = Inputs {
         e: Cow::Borrowed(&e),
         rho: Cow::Borrowed(&rho),
@@ -890,15 +1033,46 @@ pub fn apply<I: Intersector>(
         group: group.filter(|_| !sol.channels.is_empty()),
     };
     let ctx = Ctx::new(mesh, materials, isect, inputs, seed, rays, sky);
-    let gathered: Vec<Gathered> = todo.par_iter().map(|&i| ctx.gather(i)).collect();
+    let mut gathers = match more {
+        Some(Regather { mut prior, extra }) => {
+            prior.rounds += 1;
+            let round = prior.rounds;
+            let fresh: Vec<Option<Gathered>> = prior
+                .todo
+                .par_iter()
+                .map(|&i| (extra[i] > 0).then(|| ctx.gather(i, extra[i], round)))
+                .collect();
+            for (k, g2) in fresh.into_iter().enumerate() {
+                if let Some(g2) = g2 {
+                    let i = prior.todo[k];
+                    prior.got[k] = pooled(&prior.got[k], prior.asked[k], &g2, extra[i]);
+                    prior.asked[k] += extra[i];
+                }
+            }
+            prior
+        }
+        None => {
+            let todo: Vec<usize> = (0..np)
+                .filter(|&i| !faces_void(i) && scalar(&rho[i]) > 0.0)
+                .collect();
+            let n = ctx.rays;
+            let got: Vec<Gathered> = todo.par_iter().map(|&i| ctx.gather(i, n, 0)).collect();
+            Gathers {
+                asked: vec![n; todo.len()],
+                todo,
+                got,
+                ..Gathers::default()
+            }
+        }
+    };
 
     let mut sigma = shooting.parts.sigma.clone();
     let mut missing = shooting.parts.missing.clone();
     let mut b = sol.b.clone();
     let mut channels = sol.channels.clone();
-    let (mut rays_cast, mut weight_sum, mut rejected) = (0u64, 0.0, 0u64);
-    for (&i, g) in todo.iter().zip(&gathered) {
-        rays_cast += g.rays;
+    let (mut weight_sum, mut rejected) = (0.0, 0u64);
+    let mut model = Vec::with_capacity(gathers.todo.len());
+    for (&i, g) in gathers.todo.iter().zip(&gathers.got) {
         let x_s = reflected(&sol.b, i).max(0.0);
         let x_g = scalar(&[0, 1, 2].map(|q| rho[i][q] * g.h[q]));
         let mu = 0.5 * (x_s + x_g);
@@ -940,41 +1114,63 @@ pub fn apply<I: Intersector>(
                 chan.b[i][q] = ec + a * (chan.b[i][q] - ec) + (1.0 - a) * gb;
             }
         }
+        model.push(PatchModel {
+            var_s,
+            var_g: g.var,
+            biased,
+            missing: missing[i],
+            b_true: scalar(&b[i]) + missing[i],
+        });
     }
+    let seconds = t0.elapsed().as_secs_f64();
+    gathers.seconds += seconds;
+    let todo_len = gathers.todo.len();
     let stats = GatherStats {
-        patches: todo.len() as u64,
-        rays: rays_cast,
-        seconds: t0.elapsed().as_secs_f64(),
+        patches: todo_len as u64,
+        rays: gathers.rays(),
+        seconds: gathers.seconds,
         black_before,
         black_after: black(&b),
         rejected,
-        mean_shooting_weight: if todo.is_empty() {
+        mean_shooting_weight: if todo_len == 0 {
             1.0
         } else {
-            weight_sum / todo.len() as f64
+            weight_sum / todo_len as f64
         },
     };
     sol.b = b;
     sol.channels = channels;
-    sol.stats.seconds += stats.seconds;
+    sol.stats.seconds += seconds;
     sol.stats.final_gather = Some(stats);
 
     // The estimate after the gather: owed light as before, the combined σ.
-    let err = missing
+    let err: Vec<f64> = missing
         .iter()
         .zip(&sigma)
-        .map(|(m, s)| estimate::combine(*m, *s));
+        .map(|(m, s)| estimate::combine(*m, *s))
+        .collect();
     let b_true: Vec<f64> = sol
         .b
         .iter()
         .zip(&missing)
         .map(|(b, m)| scalar(b) + m)
         .collect();
-    let est = estimate::from_errors(&area, err, &b_true);
+    let est = estimate::from_errors(&area, err.iter().copied(), &b_true);
+    // What the patches not gathered add to the estimate, for a further round's plan.
+    let mut in_todo = vec![false; np];
+    for &i in &gathers.todo {
+        in_todo[i] = true;
+    }
+    gathers.fixed = (0..np)
+        .filter(|&i| !in_todo[i] && b_true[i] > 0.0)
+        .map(|i| err[i] / b_true[i])
+        .sum();
+    gathers.count = b_true.iter().filter(|&&r| r > 0.0).count();
+    gathers.model = model;
     if let Some(last) = sol.stats.trace.last().copied() {
         let total_area: f64 = area.iter().sum();
         let p = TracePoint {
-            time_s: last.time_s + stats.seconds,
+            time_s: last.time_s + seconds,
             rays: last.rays + stats.rays,
             mean_b: sol
                 .b
@@ -989,6 +1185,25 @@ pub fn apply<I: Intersector>(
         };
         sol.stats.trace.push(p);
         on_trace(&p);
+    }
+    gathers
+}
+
+/// Two independent gathers of one patch, of `n1` and `n2` rays, pooled by their rays: the
+/// mean of all n1 + n2, and the variance of that mean.
+fn pooled(g1: &Gathered, n1: usize, g2: &Gathered, n2: usize) -> Gathered {
+    let (a, b) = (n1 as f64, n2 as f64);
+    let (w1, w2) = (a / (a + b), b / (a + b));
+    Gathered {
+        h: [0, 1, 2].map(|q| w1 * g1.h[q] + w2 * g2.h[q]),
+        ch: g1
+            .ch
+            .iter()
+            .zip(&g2.ch)
+            .map(|(x, y)| [0, 1, 2].map(|q| w1 * x[q] + w2 * y[q]))
+            .collect(),
+        var: w1 * w1 * g1.var + w2 * w2 * g2.var,
+        rays: g1.rays + g2.rays,
     }
 }
 
@@ -1188,5 +1403,81 @@ impl<'a, I: Intersector> PointGather<'a, I> {
     /// (the unit of B), black without a sky; the sun's disc is left out.
     pub fn sky_exitance(&self, dir: Vec3) -> [f64; 3] {
         self.ctx.sky_exitance(dir)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gathered(h: f64, var: f64, rays: u64) -> Gathered {
+        Gathered {
+            h: [h; 3],
+            ch: vec![[h; 3]],
+            var,
+            rays,
+        }
+    }
+
+    #[test]
+    fn pooling_weighs_by_rays_and_the_variance_falls_with_them() {
+        let p = pooled(
+            &gathered(1.0, 0.04, 300),
+            256,
+            &gathered(4.0, 0.01, 900),
+            768,
+        );
+        assert!((p.h[0] - (0.25 * 1.0 + 0.75 * 4.0)).abs() < 1e-12);
+        assert!((p.ch[0][2] - p.h[2]).abs() < 1e-12);
+        // The same per-ray variance (0.04·256 = (0.04/3)·768): the pooled mean has it over 1,024.
+        let q = pooled(
+            &gathered(1.0, 0.04, 1),
+            256,
+            &gathered(1.0, 0.04 / 3.0, 1),
+            768,
+        );
+        assert!((q.var - 0.04 * 256.0 / 1024.0).abs() < 1e-12, "{}", q.var);
+        assert_eq!(p.rays, 1200);
+    }
+
+    /// Two patches gathered with 256 rays each, one with ten times the other's relative error:
+    /// the plan reaches the goal by its own model, gives the noisy one more rays, and asks
+    /// nothing of a goal already met.
+    #[test]
+    fn a_round_goes_where_the_error_is_and_reaches_its_goal() {
+        let model = |rel: f64| PatchModel {
+            var_s: f64::INFINITY,
+            var_g: (rel * 10.0f64).powi(2) / std::f64::consts::FRAC_2_PI,
+            biased: false,
+            missing: 0.0,
+            b_true: 10.0,
+        };
+        let g = Gathers {
+            todo: vec![0, 2],
+            got: vec![gathered(1.0, 0.0, 512), gathered(1.0, 0.0, 512)],
+            asked: vec![256, 256],
+            model: vec![model(0.01), model(0.1)],
+            fixed: 0.0,
+            count: 2,
+            rounds: 0,
+            seconds: 0.0,
+        };
+        let now = (g.model[0].relative(1.0) + g.model[1].relative(1.0)) / 2.0;
+        assert!((now - 0.055).abs() < 1e-9, "{now}");
+        let plan = g.plan(3, 0.03, 65_536).expect("reachable");
+        assert!(plan.predicted <= 0.03 + 1e-12, "{}", plan.predicted);
+        assert!(plan.extra[2] > plan.extra[0], "{:?}", plan.extra);
+        assert_eq!(plan.extra[1], 0);
+        assert_eq!(
+            plan.asked,
+            plan.extra.iter().map(|&x| x as u64).sum::<u64>()
+        );
+        // Two rays cast per ray asked so far.
+        assert!((plan.rays - 2.0 * plan.asked as f64).abs() < 1e-6);
+        // Met already: nothing to add.
+        let none = g.plan(3, 0.06, 65_536).expect("met");
+        assert_eq!(none.asked, 0);
+        // Unreachable within the cap: no plan.
+        assert!(g.plan(3, 1e-6, 1024).is_none());
     }
 }

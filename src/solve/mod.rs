@@ -214,6 +214,9 @@ pub struct ShotResult {
     pub b: Vec<[f64; 3]>,
     pub channels: Vec<LightChannel>,
     pub parts: estimate::Parts,
+    /// The final gather made on it, when there was one: an error target pools further gather
+    /// rounds with it (`passes`, [`final_gather::Gathers::plan`]).
+    pub gathers: Option<final_gather::Gathers>,
 }
 
 /// One light group's radiosity per patch (W/m², RGB): a *light* channel (`--per-light`), as

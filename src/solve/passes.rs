@@ -22,6 +22,13 @@
 //! the first and at most three times all so far, so a poor estimate is corrected after a pass,
 //! not after a long overshoot.
 //!
+//! **Gather rounds** (docs/design.md §8): where the final gather carries most of the result, a
+//! further pass mostly buys a better cache for a gather redone everywhere. Before each further
+//! pass, the gathers of the last combination are asked for a round of extra rays placed where
+//! the estimate's error is ([`final_gather::Gathers::plan`]); it is taken instead of the pass
+//! when it is expected to cast fewer rays than the pass and its gather (counted, not timed), and
+//! pooled with the gathers it adds to. At most [`MAX_REGATHERS`] rounds.
+//!
 //! **Judging** a combination: per patch, noise sqrt(Σ w_k² σ_kj²) and light not yet shot
 //! Σ w_k·owed_kj (each pass's own estimate's parts, kept by the driver in
 //! [`super::ShotResult`]), through [`estimate::from_errors`] — after the final gather when one is
@@ -52,6 +59,9 @@ pub struct ErrorTarget {
     pub reached: bool,
     /// Independent shooting passes averaged.
     pub passes: u32,
+    /// Further gather rounds pooled with the last pass's gather ([`MAX_REGATHERS`] at most).
+    #[serde(default)]
+    pub regathers: u32,
     /// Stopped by the default target's bound ([`super::settings::DEFAULT_ERROR_MAX_FACTOR`]).
     pub gave_up: bool,
 }
@@ -195,8 +205,17 @@ fn combine(
     (out, m, parts)
 }
 
+/// The shooting result a final gather was made on, its estimate's parts and the gathers: what
+/// a further gather round starts from.
+struct Base {
+    pre: Solution,
+    parts: Parts,
+    gathers: final_gather::Gathers,
+}
+
 /// The combination through the final gather, when the settings ask for one: rays per patch
-/// grown by `scale` (samples so far / the first pass's) so gather and shooting stay in balance.
+/// grown by `scale` (samples so far / the first pass's) so gather and shooting stay in balance;
+/// or, with `more`, a further round pooled with the gathers `base` was made with.
 #[allow(clippy::too_many_arguments)]
 fn gathered<I: Intersector>(
     mesh: &Mesh,
@@ -204,18 +223,20 @@ fn gathered<I: Intersector>(
     isect: &I,
     cfg: &SolveSettings,
     hooks: &RunHooks,
-    combined: (Solution, ErrorMetrics, Parts),
+    pre: Solution,
+    parts: Parts,
     scale: f64,
-) -> (Solution, ErrorMetrics) {
-    let (mut sol, _, parts) = combined;
+    more: Option<(final_gather::Gathers, &[usize])>,
+) -> (Solution, ErrorMetrics, Base) {
     let rays = (cfg.gather_rays_per_patch() as f64 * scale)
         .round()
         .min(super::settings::MAX_GATHER_RAYS as f64) as usize;
     let shooting = final_gather::Shooting {
         parts,
-        energy_per_ray: sol.stats.energy_per_ray,
+        energy_per_ray: pre.stats.energy_per_ray,
     };
-    final_gather::apply(
+    let mut sol = pre.clone();
+    let gathers = final_gather::apply(
         mesh,
         materials,
         isect,
@@ -226,11 +247,43 @@ fn gathered<I: Intersector>(
         cfg.sky.as_ref().and_then(|s| Sky::new(s).ok()).as_ref(),
         hooks.reference.as_deref().map(Vec::as_slice),
         &mut sol,
+        more.map(|(prior, extra)| final_gather::Regather { prior, extra }),
         &mut |_| {},
     );
     let m = estimate_of(&sol);
-    (sol, m)
+    let base = Base {
+        pre,
+        parts: shooting.parts,
+        gathers,
+    };
+    (sol, m, base)
 }
+
+/// The trace point after a combination (or a gather round): its rays count the final
+/// gather's too, as the driver's point after a gather does.
+fn trace_point(
+    out: &Solution,
+    m: ErrorMetrics,
+    start: Instant,
+    hooks: &RunHooks,
+    area: &[f64],
+) -> TracePoint {
+    let mut point = out.stats.trace.last().copied().unwrap_or_default();
+    point.time_s = start.elapsed().as_secs_f64();
+    point.shots = out.stats.shots;
+    point.rays = out.stats.rays + out.stats.final_gather.map_or(0, |g| g.rays);
+    point.cells = out.stats.hemicube_cells;
+    point.estimate = m;
+    point.error = hooks
+        .reference
+        .as_ref()
+        .map(|r| estimate::against(area, &out.b, r));
+    point
+}
+
+/// At most this many further gather rounds in one solve (each is planned to reach the target
+/// alone; a second or third only corrects the model's misses).
+pub const MAX_REGATHERS: u32 = 3;
 
 /// Shoots passes until the estimate reaches `target` (see the module notes). The first pass is
 /// `cfg` as given (with `hooks`: checkpoints, resume); later ones are seeded from it.
@@ -274,6 +327,21 @@ pub(super) fn shoot_to<I: Intersector>(
     // (samples, estimate) after the last combination, and the rate the estimate falls at.
     let mut last = (r1, m.weighted_percent);
     let mut p = 0.5;
+    // The first pass's gather, for further rounds; its rays, to cost a shooting pass's gather.
+    let first_gather_rays = out.stats.final_gather.map_or(0.0, |g| g.rays as f64);
+    let mut base = match (gather, sols[0].shooting.as_deref()) {
+        (Some(_), Some(shot)) if shot.gathers.is_some() => {
+            let (pre, _, parts) = combine(mesh, &area, &emission, &sols);
+            let gathers = shot.gathers.clone().expect("checked");
+            Some(Base {
+                pre,
+                parts,
+                gathers,
+            })
+        }
+        _ => None,
+    };
+    let mut regathers = 0;
     while m.weighted_percent > target && !budget_stopped(&sols[sols.len() - 1]) {
         let so_far: f64 = sols.iter().map(samples).sum();
         if cfg.error_max_factor.is_some_and(|f| so_far >= f * r1) {
@@ -284,6 +352,39 @@ pub(super) fn shoot_to<I: Intersector>(
         let mut rays = want.clamp(r1, 3.0 * so_far);
         if let Some(f) = cfg.error_max_factor {
             rays = rays.min((f * r1 - so_far).max(r1));
+        }
+        // A further gather round instead, when the model says it reaches the target for fewer
+        // rays than the shooting pass and its gather would cast (module notes).
+        let plan = match (gather, base.as_ref()) {
+            (Some(_), Some(b)) if regathers < MAX_REGATHERS => b.gathers.plan(
+                mesh.patches.len(),
+                AIM * target,
+                super::settings::MAX_GATHER_RAYS,
+            ),
+            _ => None,
+        };
+        let shoot_cost = rays + first_gather_rays * (so_far + rays) / r1;
+        if let (Some(isect), Some(plan)) = (gather, plan.filter(|pl| pl.rays < shoot_cost)) {
+            let b = base.take().expect("planned from it");
+            let (sol, em, nb) = gathered(
+                mesh,
+                materials,
+                isect,
+                cfg,
+                hooks,
+                b.pre,
+                b.parts,
+                1.0,
+                Some((b.gathers, &plan.extra)),
+            );
+            regathers += 1;
+            (out, m) = (sol, em);
+            base = Some(nb);
+            let point = trace_point(&out, m, start, hooks, &area);
+            on_trace(&point);
+            trace.push(point);
+            last = (so_far, m.weighted_percent);
+            continue;
         }
         let elapsed = start.elapsed().as_secs_f64();
         let used = so_far as u64;
@@ -313,20 +414,15 @@ pub(super) fn shoot_to<I: Intersector>(
         (out, m) = match gather {
             Some(isect) => {
                 let scale = sols.iter().map(samples).sum::<f64>() / r1;
-                gathered(mesh, materials, isect, cfg, hooks, combined, scale)
+                let (pre, _, parts) = combined;
+                let (sol, em, b) =
+                    gathered(mesh, materials, isect, cfg, hooks, pre, parts, scale, None);
+                base = Some(b);
+                (sol, em)
             }
             None => (combined.0, combined.1),
         };
-        let mut point = out.stats.trace.last().copied().unwrap_or_default();
-        point.time_s = start.elapsed().as_secs_f64();
-        point.shots = out.stats.shots;
-        point.rays = out.stats.rays;
-        point.cells = out.stats.hemicube_cells;
-        point.estimate = m;
-        point.error = hooks
-            .reference
-            .as_ref()
-            .map(|r| estimate::against(&area, &out.b, r));
+        let point = trace_point(&out, m, start, hooks, &area);
         on_trace(&point);
         trace.push(point);
         let now = (sols.iter().map(samples).sum::<f64>(), m.weighted_percent);
@@ -341,6 +437,7 @@ pub(super) fn shoot_to<I: Intersector>(
         estimate: m.weighted_percent,
         reached: m.weighted_percent <= target,
         passes: sols.len() as u32,
+        regathers,
         gave_up: capped,
     });
     Ok(out)
