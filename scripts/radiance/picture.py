@@ -35,6 +35,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import resource
 import shlex
 import subprocess
 import sys
@@ -71,6 +72,13 @@ def read_hdr(path: Path, env, binary: Path) -> np.ndarray:
     if data.size != h * w * 3:
         sys.exit(f"{path}: {data.size} values for {w}x{h} pixels")
     return data.reshape(h, w, 3).astype(np.float64)
+
+
+def children_cpu() -> float:
+    """CPU seconds (user + system) of the children waited for so far: the tool's threads and
+    rpict's process alike, unaffected by what else the machine runs (wall times are not)."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
 
 
 def blur3(y: np.ndarray) -> np.ndarray:
@@ -158,17 +166,19 @@ def main():
     sdir = out / "solve"
     sdir.mkdir(exist_ok=True)
     sol = sdir / "solution.rad"
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), children_cpu()
     check.run([binary, "solve", model_path, "--out", sdir, "--save", sol, "--quiet",
                "--shading", "gouraud", *solve_args])
     solve_seconds = time.perf_counter() - t0
     times = {"solve": solve_seconds}
+    cpu = {"solve": children_cpu() - c0}
     reports = {}
     for shading, extra in (("gather", shlex.split(args.render_args)), ("gouraud", [])):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), children_cpu()
         res = check.run([binary, "render", sol, "--out", out / f"tool-{shading}.hdr",
                          "--shading", shading, "--json", *cam, *extra])
         times[shading] = time.perf_counter() - t0
+        cpu[shading] = children_cpu() - c0
         reports[shading] = json.loads(res.stdout)
 
     # Radiance.
@@ -193,13 +203,15 @@ def main():
             octree = rad.octree(model, "scene", lights)
         return octree
 
-    def rpict(settings: str, path: Path) -> float:
+    def rpict(settings: str, path: Path) -> tuple[float, float]:
+        """Renders, filters down; returns (wall seconds, CPU seconds)."""
         big = path.with_suffix(".big.hdr")
         os_ = args.oversample
         cmd = [rbin / "rpict", *view, "-x", str(w * os_), "-y", str(h * os_), "-pa", "0",
                "-ps", "1", "-pt", "0", "-pj", "0.9", "-i-", *shlex.split(settings),
                octree_once()]
-        t0 = time.perf_counter()
+        octree_once()
+        t0, c0 = time.perf_counter(), children_cpu()
         with open(big, "wb") as f:
             r = subprocess.run(cmd, stdout=f, stderr=subprocess.PIPE, env=env)
         if r.returncode != 0:
@@ -211,14 +223,14 @@ def main():
             sys.exit(f"pfilt failed: {r.stderr.decode()}")
         seconds = time.perf_counter() - t0
         big.unlink()
-        return seconds
+        return seconds, children_cpu() - c0
 
     cached = json.loads(saved.read_text()) if args.reuse and saved.is_file() else None
     if cached is None or cached.get("key") != key or not ref_path.is_file():
-        ref_seconds = rpict(args.rpict, ref_path)
-        saved.write_text(json.dumps({"key": key, "seconds": ref_seconds}))
+        ref_seconds, ref_cpu = rpict(args.rpict, ref_path)
+        saved.write_text(json.dumps({"key": key, "seconds": ref_seconds, "cpu": ref_cpu}))
     else:
-        ref_seconds = cached["seconds"]
+        ref_seconds, ref_cpu = cached["seconds"], cached.get("cpu", cached["seconds"])
         print(f"Radiance's reference reused from {ref_path} (--reuse)")
 
     ref = read_hdr(ref_path, env, rbin)
@@ -249,9 +261,10 @@ def main():
     matched = []
     for k, settings in enumerate(args.matched):
         p = out / f"radiance-matched{k + 1}.hdr"
-        secs = rpict(settings, p)
+        secs, c = rpict(settings, p)
         y = read_hdr(p, env, rbin) @ LUMA
-        matched.append({"rpict": settings, "seconds": secs, **compare(y, y_ref, args.threshold)})
+        matched.append({"rpict": settings, "seconds": secs, "cpu_seconds": c,
+                        **compare(y, y_ref, args.threshold)})
 
     report = {
         "model": str(args.model),
@@ -262,33 +275,36 @@ def main():
         "tool_unit": unit,
         "threshold": args.threshold,
         "tool": {"solve_args": solve_args, "render_args": shlex.split(args.render_args),
-                 "seconds": times, "render_reports": reports, "figures": results},
+                 "seconds": times, "cpu_seconds": cpu, "render_reports": reports, "figures": results},
         "radiance": {"rpict": args.rpict, "oversample": args.oversample,
-                     "seconds": ref_seconds, "version": "pyradiance 1.3.1 (RADIANCE 6.0a)"},
+                     "seconds": ref_seconds, "cpu_seconds": ref_cpu, "version": "pyradiance 1.3.1 (RADIANCE 6.0a)"},
         "matched": matched,
     }
     (out / "report.json").write_text(json.dumps(report, indent=1))
 
     g = results["gather"]["pixels"]
     print(f"{args.model}: {w}x{h}, tool picture in {unit}")
-    print(f"{'picture':<34} {'seconds':>8} {'mean rel':>9} {'median':>8} {'signed':>8} "
-          f"{'>10 %':>7} {'blurred':>8}")
+    print(f"{'picture':<34} {'wall s':>8} {'CPU s':>8} {'mean rel':>9} {'median':>8} "
+          f"{'signed':>8} {'>10 %':>7} {'blurred':>8}")
 
-    def row(name, secs, r):
+    def row(name, secs, c, r):
         p, b = r["pixels"], r["blurred_3x3"]
-        print(f"{name:<34} {secs:>8.2f} {100 * p['mean_relative_error']:>8.2f}% "
+        print(f"{name:<34} {secs:>8.2f} {c:>8.2f} {100 * p['mean_relative_error']:>8.2f}% "
               f"{100 * p['median_relative_error']:>7.2f}% {100 * p['signed_mean_error']:>+7.2f}% "
               f"{100 * p['share_above_10_percent']:>6.1f}% {100 * b['mean_relative_error']:>7.2f}%")
 
-    row("tool --shading gather (render)", times["gather"], results["gather"])
-    row("tool --shading gouraud (render)", times["gouraud"], results["gouraud"])
-    print(f"{'tool solve':<34} {solve_seconds:>8.2f}")
-    print(f"{'rpict reference':<34} {ref_seconds:>8.2f}")
+    row("tool --shading gather (render)", times["gather"], cpu["gather"], results["gather"])
+    row("tool --shading gouraud (render)", times["gouraud"], cpu["gouraud"], results["gouraud"])
+    print(f"{'tool solve':<34} {solve_seconds:>8.2f} {cpu['solve']:>8.2f}")
+    print(f"{'rpict reference':<34} {ref_seconds:>8.2f} {ref_cpu:>8.2f}")
     for m in matched:
-        row(f"rpict {m['rpict']}"[:34], m["seconds"], m)
-    print(f"gather: {g['pixels_compared']} pixels compared; speed-up of solve + gather over the "
-          f"reference: {ref_seconds / (solve_seconds + times['gather']):.1f}x; report in "
-          f"{out / 'report.json'}")
+        row(f"rpict {m['rpict']}"[:34], m["seconds"], m["cpu_seconds"], m)
+    tool_cpu = cpu["solve"] + cpu["gather"]
+    print(f"gather: {g['pixels_compared']} pixels compared; tool solve + gather {tool_cpu:.1f} CPU s"
+          f" (reference {ref_cpu / tool_cpu:.1f}x that); report in {out / 'report.json'}")
+    for m in matched:
+        print(f"  rpict {m['rpict']}: {m['cpu_seconds'] / tool_cpu:.1f}x the tool's CPU s at "
+              f"{100 * m['pixels']['mean_relative_error']:.2f} % mean relative error")
 
 
 if __name__ == "__main__":
