@@ -25,8 +25,8 @@ the two pictures (close to pi or to 1) and says so.
     $PY scripts/radiance/picture.py scenes/office.obj --eye 2.7,1.6,-0.4 --target 2.7,1.1,-5.6 \\
         --fov 60 --out out/picture/office
 
-Writes DIR/report.json, the pictures (tool-gather.hdr, tool-gouraud.hdr, radiance.hdr, PNGs)
-and DIR/error.png (relative error per pixel, black 0 to white 20 %+), and prints a short table.
+Writes DIR/report.json, the pictures (tool-gather.hdr, tool-gouraud.hdr, radiance.hdr, PNGs),
+DIR/side-by-side.png (Radiance | final gather | Gouraud, one exposure) and DIR/error.png (relative error per pixel, black 0 to white 20 %+), and prints a short table.
 Exit code 1 only when something fails to run.
 """
 
@@ -237,6 +237,7 @@ def main():
     y_ref = ref @ LUMA
     results = {}
     unit = None
+    panels = {}
     for shading in ("gather", "gouraud"):
         img = read_hdr(out / f"tool-{shading}.hdr", env, rbin)
         if img.shape != ref.shape:
@@ -249,6 +250,8 @@ def main():
                 ratio - 1) else "radiance (W/sr/m^2)"
         if unit.startswith("radiosity"):
             y = y / math.pi
+            img = img / math.pi
+        panels[shading] = img
         results[shading] = compare(y, y_ref, args.threshold)
         if shading == "gather":
             scale = 0.9 / max(float(np.percentile(y_ref, 97)), 1e-30)
@@ -257,6 +260,13 @@ def main():
             lit = (y_ref > args.threshold * y_ref.mean()) & (y > args.threshold * y_ref.mean())
             err = np.where(lit, np.abs(y - y_ref) / np.maximum(y_ref, 1e-30), 0.0)
             write_png(out / "error.png", np.repeat(err[..., None], 3, -1), 5.0)
+
+    # Side by side, one exposure for all (the reference's 97th percentile of Y at 0.9):
+    # Radiance | the tool's final gather | its Gouraud preview, 8 px apart.
+    scale = 0.9 / max(float(np.percentile(y_ref, 97)), 1e-30)
+    gap = np.ones((ref.shape[0], 8, 3)) / scale
+    write_png(out / "side-by-side.png",
+              np.concatenate([ref, gap, panels["gather"], gap, panels["gouraud"]], axis=1), scale)
 
     matched = []
     for k, settings in enumerate(args.matched):
