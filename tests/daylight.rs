@@ -223,6 +223,49 @@ fn tinted_glazing_passes_each_channel_its_own_transmittance() {
     }
 }
 
+/// A tinted pane that reflects more of a channel than the mean T leaves to land (ρ_b = 0.9 >
+/// 1 − T = 0.38: its rays that land keep ρ_b / (1 − T) > 1 of that channel, unclamped) still
+/// reflects ρ_c of the sky's light in each channel, shooting alone, and the books close.
+#[test]
+fn a_tinted_pane_reflects_rho_per_channel_even_where_rho_exceeds_one_minus_t() {
+    let mut s = plane();
+    s.materials[0] = Material {
+        name: "glass".into(),
+        rho: [0.05, 0.05, 0.9],
+        transmittance: (0.9 + 0.9 + 0.05) / 3.0,
+        transmittance_rgb: Some([0.9, 0.9, 0.05]),
+        ..Material::default()
+    };
+    let spec = sky(SkyKind::Uniform, None);
+    let m = mesh_at(&s, Some(0.5));
+    let cfg = SolveSettings {
+        sky: Some(spec),
+        final_gather: false,
+        ..SolveSettings::default()
+    };
+    let sol = solve_mesh(&s, &m, &cfg);
+    let e = &sol.stats.energy;
+    assert!(e.relative_residual() < 1e-9, "{e:?}");
+    let horizontal = 10_000.0 / EFFICACY;
+    let (mut b, mut area) = ([0.0; 3], 0.0);
+    for (p, bj) in m.patches.iter().zip(&sol.b) {
+        if p.normal.y > 0.9 {
+            for q in 0..3 {
+                b[q] += bj[q] * p.area;
+            }
+            area += p.area;
+        }
+    }
+    for q in 0..3 {
+        let want = s.materials[0].rho[q] * horizontal;
+        let got = b[q] / area;
+        assert!(
+            (got / want - 1.0).abs() < 0.02,
+            "channel {q}: B {got}, want {want}"
+        );
+    }
+}
+
 /// Grey glazing whose colour is given (T_c = T in every channel) solves exactly as grey
 /// glazing without one: its tint factor is 1 and is never applied.
 #[test]
