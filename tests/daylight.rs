@@ -256,9 +256,9 @@ fn a_tinted_pane_reflects_rho_per_channel_even_where_rho_exceeds_one_minus_t() {
             area += p.area;
         }
     }
-    for q in 0..3 {
-        let want = s.materials[0].rho[q] * horizontal;
-        let got = b[q] / area;
+    for (q, (bq, rho)) in b.iter().zip(s.materials[0].rho).enumerate() {
+        let want = rho * horizontal;
+        let got = bq / area;
         assert!(
             (got / want - 1.0).abs() < 0.02,
             "channel {q}: B {got}, want {want}"
