@@ -619,6 +619,20 @@ fn check_consistent(s: &SavedSolution) -> Result<(), String> {
     {
         return Err("a value is not finite".into());
     }
+    // Glazing passes rays with probability T and tints them by T_c / T: both must be shares.
+    let share = |t: f64| (0.0..=1.0).contains(&t);
+    for mat in &s.meta.materials {
+        if !share(mat.transmittance)
+            || !mat
+                .transmittance_rgb
+                .is_none_or(|c| c.into_iter().all(share))
+        {
+            return Err(format!(
+                "material '{}': a transmittance is not within [0, 1]",
+                mat.name
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -756,5 +770,10 @@ mod tests {
         let mat = back.meta.materials[0].material();
         assert_eq!(mat.transmittance_rgb(), [0.2, 0.6, 0.4]);
         assert!(mat.is_tinted());
+
+        // A damaged colour is refused, not drawn.
+        s.meta.materials[0].transmittance_rgb = Some([0.2, 1.6, 0.4]);
+        let e = SavedSolution::from_bytes(Path::new("x.rad"), &bytes(&s)).unwrap_err();
+        assert!(e.to_string().contains("transmittance"), "{e}");
     }
 }
