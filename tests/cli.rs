@@ -187,6 +187,46 @@ fn info_shows_where_each_reflectance_came_from() {
     assert_eq!(json["materials"][1]["rho_source"]["kind"], "kd");
 }
 
+/// Tinted glazing: `info` shows its colour and mean (text and JSON); a negative `Tf` channel is
+/// a user error (one line, exit 2, no panic).
+#[test]
+fn info_shows_the_tint_of_glazing() {
+    let d = tempfile::tempdir().unwrap();
+    let mtl = LIT_MTL.replace(
+        "Kd 0.5 0.5 0.5\nnewmtl",
+        "Kd 0.05 0.05 0.05\nTf 0.2 0.6 0.3\nillum 4\nnewmtl",
+    );
+    write(d.path(), "m.mtl", &mtl);
+    let f = write(d.path(), "tint.obj", LIT_OBJ);
+    let (code, stdout, err) = run(&["info", &f]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        stdout.contains("glazing: transmittance 0.367 (mean), tinted 0.200 0.600 0.300"),
+        "{stdout}"
+    );
+    let (code, stdout, err) = run(&["info", "--json", &f]);
+    assert_eq!(code, 0, "{err}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let white = &json["materials"][0];
+    assert_eq!(
+        white["transmittance_rgb"],
+        serde_json::json!([0.2, 0.6, 0.3])
+    );
+    assert!((white["transmittance"].as_f64().unwrap() - 1.1 / 3.0).abs() < 1e-12);
+    // Opaque materials show their (zero) transmittance in every channel.
+    assert_eq!(
+        json["materials"][1]["transmittance_rgb"],
+        serde_json::json!([0.0, 0.0, 0.0])
+    );
+
+    write(
+        d.path(),
+        "m.mtl",
+        &mtl.replace("Tf 0.2 0.6 0.3", "Tf 0.2 -0.6 0.9"),
+    );
+    assert_user_error(&["info", &f], &["white", "negative in a channel"]);
+}
+
 #[test]
 fn no_emitter_suggests_emit() {
     let d = tempfile::tempdir().unwrap();

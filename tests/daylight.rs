@@ -87,6 +87,15 @@ fn a_closed_box_under_a_sky_and_sun_receives_nothing() {
 
 /// The closed box with its roof (y = 3) replaced: open, or a pane of transmittance 0.7.
 fn roofed(glass: bool) -> Scene {
+    roofed_with(glass.then(|| Material {
+        name: "glass".into(),
+        transmittance: 0.7,
+        ..Material::default()
+    }))
+}
+
+/// The closed box with its roof (y = 3) replaced by a pane of `glass`, or open (`None`).
+fn roofed_with(glass: Option<Material>) -> Scene {
     let mut s = closed_box(4.0, 3.0, 4.0, material("wall", 0.6, 0.0));
     let roof = s
         .polygons
@@ -96,12 +105,8 @@ fn roofed(glass: bool) -> Scene {
             idx.iter().all(|&i| s.positions[i as usize].y == 3.0)
         })
         .unwrap();
-    if glass {
-        s.materials.push(Material {
-            name: "glass".into(),
-            transmittance: 0.7,
-            ..Material::default()
-        });
+    if let Some(glass) = glass {
+        s.materials.push(glass);
         s.polygons[roof].material = 1;
     } else {
         s.polygons.remove(roof);
@@ -119,6 +124,216 @@ fn glazing_passes_its_transmittance_and_the_books_close() {
     assert!((eg / eo - 0.7).abs() < 0.02, "glazed {eg} / open {eo}");
     // The pane is two-sided: light from outside is not lost on its back.
     assert!(glazed.stats.energy.back_fraction() < 1e-9);
+}
+
+/// A black pane (ρ = 0) of tinted glass: T_c = 0.2 0.6 0.3, T = their mean.
+fn tinted_glass() -> Material {
+    let rgb = [0.2, 0.6, 0.3];
+    Material {
+        name: "glass".into(),
+        transmittance: (rgb[0] + rgb[1] + rgb[2]) / 3.0,
+        transmittance_rgb: Some(rgb),
+        ..Material::default()
+    }
+}
+
+/// Area-weighted mean irradiance per channel (W/m²) over the floor's patches.
+fn floor_irradiance(m: &radiosity::mesh::Mesh, sol: &Solution, rho: f64) -> [f64; 3] {
+    let (mut sum, mut area) = ([0.0; 3], 0.0);
+    for (p, b) in m.patches.iter().zip(&sol.b) {
+        if p.centre.y < 1e-3 && p.normal.y > 0.9 {
+            for q in 0..3 {
+                sum[q] += b[q] / rho * p.area;
+            }
+            area += p.area;
+        }
+    }
+    sum.map(|s| s / area)
+}
+
+/// Docs/design.md §9, "Tinted glazing": rays go through a pane with probability T (the mean)
+/// and carry T_c / T per channel on. Every path into the box crosses the black pane once, so
+/// each channel of the floor's irradiance is T_c of the open box's, within the noise; the
+/// books close per channel; per-light channels still sum to B.
+#[test]
+fn tinted_glazing_passes_each_channel_its_own_transmittance() {
+    use radiosity::solve::lights::{LightGroups, SKY_CHANNEL, SUN_CHANNEL};
+    let rgb = tinted_glass().transmittance_rgb.unwrap();
+    let specs = [
+        sky(SkyKind::Uniform, None),
+        sky(SkyKind::Clear, Some((50.0, 20.0))),
+    ];
+    // Shooting alone, and with the final gather (which sees through panes by T_c).
+    for (spec, final_gather) in specs.iter().flat_map(|s| [(s, false), (s, true)]) {
+        let cfg = SolveSettings {
+            sky: Some(*spec),
+            final_gather,
+            ..SolveSettings::default()
+        };
+        let open_scene = roofed(false);
+        let mo = mesh_at(&open_scene, Some(0.5));
+        let open = solve_mesh(&open_scene, &mo, &cfg);
+        let s = roofed_with(Some(tinted_glass()));
+        let m = mesh_at(&s, Some(0.5));
+        let hooks = radiosity::solve::RunHooks {
+            light_groups: Some(std::sync::Arc::new(LightGroups {
+                names: vec![SKY_CHANNEL.into(), SUN_CHANNEL.into()],
+                of_patch: vec![u32::MAX; m.patches.len()],
+            })),
+            ..Default::default()
+        };
+        let tinted = common::solve_mesh_with(&s, &m, &cfg, &hooks);
+        let e = &tinted.stats.energy;
+        assert!(e.relative_residual() < 1e-9, "{e:?}");
+        let (eo, eg) = (
+            floor_irradiance(&mo, &open, 0.6),
+            floor_irradiance(&m, &tinted, 0.6),
+        );
+        // Shooting alone scatters about 1.6 % over seeds here (12 seeds: mean 0.998 of the
+        // tint); the gather about a third of that.
+        let tol = if final_gather { 0.03 } else { 0.06 };
+        for q in 0..3 {
+            let ratio = eg[q] / eo[q];
+            assert!(
+                (ratio / rgb[q] - 1.0).abs() < tol,
+                "{:?}: channel {q}: tinted {} / open {} = {ratio}, want {}",
+                spec.kind,
+                eg[q],
+                eo[q],
+                rgb[q]
+            );
+        }
+        // Behind a black pane every path carries the same T_c / T, so the channels differ by
+        // the tint alone: to rounding, not to noise.
+        let per = [0, 1, 2].map(|q| eg[q] / eo[q] / rgb[q]);
+        assert!(
+            (per[0] / per[1] - 1.0).abs() < 1e-9 && (per[2] / per[1] - 1.0).abs() < 1e-9,
+            "{per:?}"
+        );
+        // The sky's and the sun's channels still sum to B through tinted glass.
+        for (j, b) in tinted.b.iter().enumerate() {
+            for (q, bq) in b.iter().enumerate() {
+                let sum: f64 = tinted.channels.iter().map(|c| c.b[j][q]).sum();
+                assert!(
+                    (sum - bq).abs() <= 1e-9 * bq.max(1e-12),
+                    "patch {j}: {sum} vs {bq}"
+                );
+            }
+        }
+    }
+}
+
+/// A tinted pane that reflects more of a channel than the mean T leaves to land (ρ_b = 0.9 >
+/// 1 − T = 0.38: its rays that land keep ρ_b / (1 − T) > 1 of that channel, unclamped) still
+/// reflects ρ_c of the sky's light in each channel, shooting alone, and the books close.
+#[test]
+fn a_tinted_pane_reflects_rho_per_channel_even_where_rho_exceeds_one_minus_t() {
+    let mut s = plane();
+    s.materials[0] = Material {
+        name: "glass".into(),
+        rho: [0.05, 0.05, 0.9],
+        transmittance: (0.9 + 0.9 + 0.05) / 3.0,
+        transmittance_rgb: Some([0.9, 0.9, 0.05]),
+        ..Material::default()
+    };
+    let spec = sky(SkyKind::Uniform, None);
+    let m = mesh_at(&s, Some(0.5));
+    let cfg = SolveSettings {
+        sky: Some(spec),
+        final_gather: false,
+        ..SolveSettings::default()
+    };
+    let sol = solve_mesh(&s, &m, &cfg);
+    let e = &sol.stats.energy;
+    assert!(e.relative_residual() < 1e-9, "{e:?}");
+    let horizontal = 10_000.0 / EFFICACY;
+    let (mut b, mut area) = ([0.0; 3], 0.0);
+    for (p, bj) in m.patches.iter().zip(&sol.b) {
+        if p.normal.y > 0.9 {
+            for q in 0..3 {
+                b[q] += bj[q] * p.area;
+            }
+            area += p.area;
+        }
+    }
+    for (q, (bq, rho)) in b.iter().zip(s.materials[0].rho).enumerate() {
+        let want = rho * horizontal;
+        let got = bq / area;
+        assert!(
+            (got / want - 1.0).abs() < 0.02,
+            "channel {q}: B {got}, want {want}"
+        );
+    }
+}
+
+/// Grey glazing whose colour is given (T_c = T in every channel) solves exactly as grey
+/// glazing without one: its tint factor is 1 and is never applied.
+#[test]
+fn grey_glazing_with_a_colour_solves_bit_for_bit_as_without() {
+    let grey = |rgb: Option<[f64; 3]>| Material {
+        name: "glass".into(),
+        transmittance: 0.5,
+        transmittance_rgb: rgb,
+        rho: [0.1; 3],
+        ..Material::default()
+    };
+    let spec = sky(SkyKind::Clear, Some((50.0, 20.0)));
+    let (_, a) = solve(&roofed_with(Some(grey(None))), spec);
+    let (_, b) = solve(&roofed_with(Some(grey(Some([0.5; 3])))), spec);
+    assert_eq!(a.b, b.b);
+    assert_eq!(a.stats.energy.absorbed, b.stats.energy.absorbed);
+}
+
+/// The sensors (`--grid`) and the gathered picture see through tinted glass per channel: a
+/// camera ray through the pane carries T_c, and sensors on the floor of the glazed box read
+/// T_c of the open box's irradiance per channel.
+#[test]
+fn sensors_and_the_gathered_picture_see_the_tint() {
+    use radiosity::intersect::embree::EmbreeScene;
+    use radiosity::solve::final_gather::{sensor_irradiance, PointGather};
+    let spec = sky(SkyKind::Uniform, None);
+    let skyl = radiosity::sky::Sky::new(&spec).unwrap();
+    let rgb = tinted_glass().transmittance_rgb.unwrap();
+    let sensors: Vec<(Vec3, Vec3)> = [(1.0, 1.0), (2.0, 2.0), (3.0, 1.5), (1.5, 3.0)]
+        .iter()
+        .map(|&(x, z)| (vec3(x, 0.8, z), Vec3::Y))
+        .collect();
+    let mut h = Vec::new();
+    for glass in [None, Some(tinted_glass())] {
+        let s = roofed_with(glass);
+        let (m, sol) = solve(&s, spec);
+        let isect = EmbreeScene::build(&m, |_| true).unwrap();
+        let e = sensor_irradiance(
+            &m,
+            &s.materials,
+            &isect,
+            &sol.b,
+            Some(&skyl),
+            &sensors,
+            4096,
+            7,
+        );
+        let mean = [0, 1, 2].map(|q| e.iter().map(|v| v[q]).sum::<f64>() / e.len() as f64);
+        h.push(mean);
+        if s.materials.len() > 1 {
+            let g = PointGather::new(&m, &s.materials, &isect, &sol.b, Some(&skyl), None);
+            let seen = g.view(vec3(2.0, 10.0, 2.0), vec3(0.0, -1.0, 0.0));
+            assert!(seen.hit.is_some());
+            let off = (0..3).map(|q| (seen.through[q] - rgb[q]).abs());
+            assert!(off.fold(0.0, f64::max) < 1e-12, "{:?}", seen.through);
+        }
+    }
+    let per = [0, 1, 2].map(|q| h[1][q] / h[0][q] / rgb[q]);
+    for q in 0..3 {
+        assert!(
+            (per[q] - 1.0).abs() < 0.04,
+            "channel {q}: {per:?} of the tint"
+        );
+        assert!(
+            (per[q] / per[1] - 1.0).abs() < 1e-9,
+            "channels differ by more than the tint: {per:?}"
+        );
+    }
 }
 
 #[test]

@@ -14,14 +14,21 @@ transmittance T, read by the tool's rule (``src/scene/obj/mtl.rs``, ``transmitta
 (or ``Tr`` > 0 without ``d``) gives T = (1 - d) x mean ``Tf`` (1 without ``Tf``); else a
 transparency ``illum`` (4, 6, 7, 9) with ``Tf`` gives T = mean ``Tf``; else a ``Tf`` strictly
 between 0 and 1 in some channel gives T = mean ``Tf``; else opaque (exporters write ``Tf 1 1 1``
-with ``d 1`` on opaque materials: Sponza's and Sibenik's MTL do). T is grey, and at most
-1 - max rho. Its ``Kd`` (rho) stays the pane's diffuse reflectance. In Radiance such a pane is
-``trans`` with no specular reflection (spec 0) and all its transmission specular (tspec 1): its
-diffuse reflectance is c (1 - t) and its straight-through transmittance c t, so c = rho + T and
-t = T / (rho + T) match the pane exactly (see :func:`trans_parameters`). ``glass`` would not do:
-it adds Fresnel reflection and its parameter is a transmissivity, not a transmittance.
-Radiance's shadow rays (the sun) and ambient rays go through ``trans`` straight on with factor
-c t (``scripts/radiance/README.md``, "Daylight", has the check).
+with ``d 1`` on opaque materials: Sponza's and Sibenik's MTL do). The same rule per channel
+gives the colour T_c (e.g. (1 - d) x ``Tf``_c): grey glazing (equal channels) has T in every
+channel, at most 1 - max rho; tinted glazing (channels that differ) keeps its colour, each
+channel at most 1 - rho_c (docs/design.md §9, "Tinted glazing"). Its ``Kd`` (rho) stays the
+pane's diffuse reflectance. In Radiance a grey pane is ``trans`` with no specular reflection
+(spec 0) and all its transmission specular (tspec 1): its diffuse reflectance is c (1 - t) and
+its straight-through transmittance c t, so c = rho + T and t = T / (rho + T) match the pane
+exactly (see :func:`trans_parameters`). ``glass`` would not do: it adds Fresnel reflection and
+its parameter is a transmissivity, not a transmittance. Radiance's shadow rays (the sun) and
+ambient rays go through ``trans`` straight on with factor c t (``scripts/radiance/README.md``,
+"Daylight", has the check). ``trans`` has one t for the three channels, so a pane whose
+T_c / (rho_c + T_c) differs by channel (tinted glass) is written as ``BRTDfunc`` instead:
+specular transmission T_c per channel, diffuse reflectance rho_c on both sides, nothing else
+(:func:`brtd_pane`); Radiance's ``m_brdf`` casts its transmitted ray for shadow and ambient
+rays too, with the coefficient T_c.
 """
 
 from __future__ import annotations
@@ -170,18 +177,31 @@ def numbers(rest: str) -> list:
 
 
 def transmittance(m: Material, tf_rule: str, warnings: list) -> tuple:
-    """T (grey, per channel) from the material's Tf / d / Tr / illum, the tool's rule (see the
-    module docstring); ``tf_rule`` is kept for the command line and must be "tool"."""
+    """T per channel from the material's Tf / d / Tr / illum, the tool's rule (see the module
+    docstring): grey (T, T, T) when Tf's channels are equal, else Tf's colour T_c;
+    ``tf_rule`` is kept for the command line and must be "tool"."""
     mean = (lambda c: sum(c) / 3.0)
     opacity = m.d if m.d is not None else (1.0 - m.tr if m.tr is not None else None)
+    colour, scale = None, 1.0
     if opacity is not None and opacity < 1.0:
         t = (1.0 - opacity) * (mean(m.tf) if m.tf is not None else 1.0)
+        colour, scale = m.tf, 1.0 - opacity
     elif m.tf is not None and m.illum in (4, 6, 7, 9):
         t = mean(m.tf)
+        colour = m.tf
     elif m.tf is not None and any(0.0 < x < 1.0 for x in m.tf):
         t = mean(m.tf)
+        colour = m.tf
     else:
         t = 0.0
+    if t > 0.0 and colour is not None and len(set(colour)) > 1:
+        # Tinted: each channel at most 1 - rho_c (the tool's `glazing` in mtl.rs).
+        tc = tuple(scale * x for x in colour)
+        kept = tuple(min(x, max(0.0, 1.0 - r)) for x, r in zip(tc, m.rho))
+        if kept != tc:
+            warnings.append(f"material {m.name!r}: transmittance {tc} cut to {kept} "
+                            "(rho_c + T_c <= 1)")
+        return kept
     room = max(0.0, 1.0 - max(m.rho))
     if t > room:
         warnings.append(f"material {m.name!r}: transmittance {t:g} cut to {room:g} (rho + T <= 1)")
@@ -202,6 +222,15 @@ def trans_parameters(rho, t):
     t_r = num / den if den > 0 else 0.0
     exact = max(ratios) - min(ratios) < 1e-9
     return c, t_r, exact
+
+
+def brtd_pane(rho, t) -> str:
+    """The real and string arguments of a Radiance ``BRTDfunc`` pane of diffuse reflectance
+    ``rho`` (both sides) and straight-through (specular) transmittance ``t`` per channel, with
+    no specular reflection, directional-diffuse part or diffuse transmission: exact per
+    channel, where ``trans`` cannot be (its t is one number)."""
+    return ("10 0 0 0 " + " ".join(f"{x:.9g}" for x in t) + " 0 0 0 .\n0\n"
+            + "9 " + " ".join(f"{x:.9g}" for x in tuple(rho) * 2) + " 0 0 0")
 
 
 def read_mtl(path: Path, warnings: list, tf_rule: str = "tool") -> dict:
@@ -350,11 +379,16 @@ def write_rad(model: Model, path: Path, light_radiance: dict | None = None):
             out.append(f"void light m{k}\n0\n0\n3 {m.ke[0]:.9g} {m.ke[1]:.9g} {m.ke[2]:.9g}")
         elif m.transmits:
             c, t_r, exact = trans_parameters(m.rho, m.transmittance)
-            out.append(f"# {m.name}: rho {m.rho}, straight-through T {m.transmittance}: trans "
-                       f"c = rho + T, t = T / (rho + T), spec 0, tspec 1"
-                       + ("" if exact else " (not exact: T / (rho + T) differs by channel)"))
-            out.append(f"void trans m{k}\n0\n0\n7 {c[0]:.9g} {c[1]:.9g} {c[2]:.9g} 0 0 "
-                       f"{t_r:.9g} 1")
+            if exact:
+                out.append(f"# {m.name}: rho {m.rho}, straight-through T {m.transmittance}: "
+                           "trans c = rho + T, t = T / (rho + T), spec 0, tspec 1")
+                out.append(f"void trans m{k}\n0\n0\n7 {c[0]:.9g} {c[1]:.9g} {c[2]:.9g} 0 0 "
+                           f"{t_r:.9g} 1")
+            else:
+                # Tinted (or T / (rho + T) differs by channel): trans's one t cannot match.
+                out.append(f"# {m.name}: rho {m.rho}, straight-through T {m.transmittance}: "
+                           "BRTDfunc, specular transmission T_c, diffuse reflectance rho_c")
+                out.append(f"void BRTDfunc m{k}\n{brtd_pane(m.rho, m.transmittance)}")
         else:
             out.append(f"# {m.name}: rho {m.rho} ({m.rho_source})")
             out.append(f"void plastic m{k}\n0\n0\n5 {m.rho[0]:.9g} {m.rho[1]:.9g} "

@@ -61,6 +61,11 @@ pub struct SavedMaterial {
     /// kept (panes then look opaque).
     #[serde(default)]
     pub transmittance: f64,
+    /// Tinted glazing's transmittance per channel (`Material::transmittance_rgb`); absent for
+    /// grey glazing and in files written before colour was kept (read as grey: `transmittance`
+    /// in every channel). Optional in the `META` JSON, so the format's version is unchanged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transmittance_rgb: Option<[f64; 3]>,
 }
 
 impl SavedMaterial {
@@ -72,6 +77,7 @@ impl SavedMaterial {
             ke: self.ke,
             rho_source: crate::scene::RhoSource::Kd,
             transmittance: self.transmittance,
+            transmittance_rgb: self.transmittance_rgb,
         }
     }
 }
@@ -613,6 +619,20 @@ fn check_consistent(s: &SavedSolution) -> Result<(), String> {
     {
         return Err("a value is not finite".into());
     }
+    // Glazing passes rays with probability T and tints them by T_c / T: both must be shares.
+    let share = |t: f64| (0.0..=1.0).contains(&t);
+    for mat in &s.meta.materials {
+        if !share(mat.transmittance)
+            || !mat
+                .transmittance_rgb
+                .is_none_or(|c| c.into_iter().all(share))
+        {
+            return Err(format!(
+                "material '{}': a transmittance is not within [0, 1]",
+                mat.name
+            ));
+        }
+    }
     Ok(())
 }
 
@@ -658,6 +678,7 @@ mod tests {
                     rho: [0.5; 3],
                     ke: [1.0; 3],
                     transmittance: 0.0,
+                    transmittance_rgb: None,
                 }],
                 settings: serde_json::Value::Null,
             },
@@ -724,5 +745,35 @@ mod tests {
         assert!(s.check_scene(Path::new("x.rad"), "unit", 42).is_ok());
         let e = s.check_scene(Path::new("x.rad"), "other", 43).unwrap_err();
         assert!(e.to_string().contains("another scene"), "{e}");
+    }
+
+    /// A material saved before glazing kept its colour (no `transmittance_rgb` in the META
+    /// JSON) reads as grey glazing; tinted glazing's colour round-trips, and grey glazing
+    /// writes no colour (so its files are as before).
+    #[test]
+    fn glazing_colour_is_optional_and_old_files_read_as_grey() {
+        let old = r#"{"name":"glass","rho":[0.1,0.1,0.1],"ke":[0,0,0],"transmittance":0.6}"#;
+        let m: SavedMaterial = serde_json::from_str(old).unwrap();
+        assert_eq!(m.transmittance_rgb, None);
+        let mat = m.material();
+        assert_eq!(mat.transmittance_rgb(), [0.6; 3]);
+        assert_eq!(mat.tint(), [1.0; 3]);
+        assert!(!serde_json::to_string(&m)
+            .unwrap()
+            .contains("transmittance_rgb"));
+
+        let mut s = sample();
+        s.meta.materials[0].transmittance = 0.4;
+        s.meta.materials[0].transmittance_rgb = Some([0.2, 0.6, 0.4]);
+        let back = SavedSolution::from_bytes(Path::new("x.rad"), &bytes(&s)).unwrap();
+        assert_eq!(back, s);
+        let mat = back.meta.materials[0].material();
+        assert_eq!(mat.transmittance_rgb(), [0.2, 0.6, 0.4]);
+        assert!(mat.is_tinted());
+
+        // A damaged colour is refused, not drawn.
+        s.meta.materials[0].transmittance_rgb = Some([0.2, 1.6, 0.4]);
+        let e = SavedSolution::from_bytes(Path::new("x.rad"), &bytes(&s)).unwrap_err();
+        assert!(e.to_string().contains("transmittance"), "{e}");
     }
 }

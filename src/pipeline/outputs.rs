@@ -373,6 +373,7 @@ fn save_solution(
                 rho: mat.rho,
                 ke: mat.ke,
                 transmittance: mat.transmittance,
+                transmittance_rgb: mat.transmittance_rgb,
             })
             .collect(),
         settings: job.settings.to_json(),

@@ -135,19 +135,19 @@ fn primary_ray(camera: &Camera, x: f32, y: f32, width: f32, height: f32) -> Opti
     (org.is_finite() && dir.is_finite() && dir != Vec3::ZERO).then_some((org, dir))
 }
 
-/// `sum` += `w`·`v`, per channel.
-fn add(sum: &mut [f64; 3], v: [f64; 3], w: f64) {
-    for (s, v) in sum.iter_mut().zip(v) {
+/// `sum` += `w`·`v`, per channel (`w` per channel too: tinted glazing's transmittance).
+fn add(sum: &mut [f64; 3], v: [f64; 3], w: [f64; 3]) {
+    for ((s, v), w) in sum.iter_mut().zip(v).zip(w) {
         *s += w * v;
     }
 }
 
-/// The samples of one pixel that met one side: its points and their weight (the glazing's
-/// transmittance before them, summed).
+/// The samples of one pixel that met one side: its points and their weight per channel (the
+/// glazing's transmittance before them, summed).
 struct Group {
     patch: usize,
     points: Vec<Vec3>,
-    weight: f64,
+    weight: [f64; 3],
 }
 
 /// Renders the view of `camera` by a final gather per pixel through `gather` (see the module
@@ -199,12 +199,14 @@ pub fn render_gather<I: Intersector>(
                     };
                     let seen = gather.view(org, dir);
                     cast += seen.rays;
-                    add(&mut sum, seen.panes, 1.0);
+                    add(&mut sum, seen.panes, [1.0; 3]);
                     match seen.hit {
                         Some(h) => match groups.iter_mut().find(|g| g.patch == h.patch) {
                             Some(g) => {
                                 g.points.push(h.point);
-                                g.weight += seen.through;
+                                for q in 0..3 {
+                                    g.weight[q] += seen.through[q];
+                                }
                             }
                             None => groups.push(Group {
                                 patch: h.patch,

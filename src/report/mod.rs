@@ -32,8 +32,11 @@ pub struct MaterialInfo {
     /// object whose `kind` says which).
     pub rho_source: RhoSource,
     pub ke: [f64; 3],
-    /// Glazing's straight-through transmittance (0: opaque).
+    /// Glazing's straight-through transmittance (0: opaque): the mean of its colour.
     pub transmittance: f64,
+    /// Glazing's transmittance per channel: its colour when tinted, `transmittance` in every
+    /// channel when grey (or opaque).
+    pub transmittance_rgb: [f64; 3],
     pub polygons: usize,
 }
 
@@ -130,6 +133,7 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
                 rho_source: m.rho_source.clone(),
                 ke: m.ke,
                 transmittance: m.transmittance,
+                transmittance_rgb: m.transmittance_rgb(),
                 polygons,
             })
             .collect(),
@@ -182,11 +186,20 @@ impl std::fmt::Display for SceneInfo {
             )?;
             writeln!(f, "  {:<20} rho from {}", "", m.rho_source)?;
             if m.transmittance > 0.0 {
-                writeln!(
-                    f,
-                    "  {:<20} glazing: transmittance {:.3}",
-                    "", m.transmittance
-                )?;
+                let t = m.transmittance_rgb;
+                if t[0] == t[1] && t[1] == t[2] {
+                    writeln!(
+                        f,
+                        "  {:<20} glazing: transmittance {:.3} (grey)",
+                        "", m.transmittance
+                    )?;
+                } else {
+                    writeln!(
+                        f,
+                        "  {:<20} glazing: transmittance {:.3} (mean), tinted {:.3} {:.3} {:.3}",
+                        "", m.transmittance, t[0], t[1], t[2]
+                    )?;
+                }
             }
         }
         writeln!(f, "lights         {}", self.lights.len())?;

@@ -60,9 +60,16 @@ pub struct Material {
     /// Where [`Material::rho`] came from (shown by `radiosity info`).
     pub rho_source: RhoSource,
     /// Glazing (issue 14): the share of light that goes straight through, unchanged in
-    /// direction (grey; 0 for opaque). ρ + transmittance ≤ 1; the rest is absorbed. Read from
+    /// direction (0 for opaque); for tinted glazing, the mean of
+    /// [`Material::transmittance_rgb`]. A ray meeting a pane goes through with this
+    /// probability (docs/design.md §9). ρ + transmittance ≤ 1; the rest is absorbed. Read from
     /// the MTL by `scene::obj`'s rule (`Tf`, `d`, `Tr`, `illum`).
     pub transmittance: f64,
+    /// Tinted glazing's transmittance per channel T_c (`Tf`'s colour), ρ_c + T_c ≤ 1; `None`
+    /// for grey glazing (every channel [`Material::transmittance`]) and for opaque materials.
+    /// Kept apart from the mean so that grey glazing stays exactly what it was: its rays carry
+    /// their energy on untouched (docs/design.md §9, "Tinted glazing").
+    pub transmittance_rgb: Option<[f64; 3]>,
 }
 
 /// Where a material's reflectance ρ came from.
@@ -123,6 +130,29 @@ impl Material {
 
     pub fn is_emitter(&self) -> bool {
         self.ke.iter().any(|&k| k > 0.0)
+    }
+
+    /// Straight-through transmittance per channel T_c: the colour of tinted glazing, T in
+    /// every channel otherwise.
+    pub fn transmittance_rgb(&self) -> [f64; 3] {
+        self.transmittance_rgb.unwrap_or([self.transmittance; 3])
+    }
+
+    /// The factor per channel T_c / T that a ray going through this glazing multiplies its
+    /// energy by: it goes through with probability T (the mean, so that every ray that
+    /// leaves a shooter carries the same energy, Sec. 2 of the paper), so its channels come
+    /// out unbiased, T·(T_c/T) = T_c. Exactly 1 for grey glazing and opaque materials
+    /// (docs/design.md §9, "Tinted glazing").
+    pub fn tint(&self) -> [f64; 3] {
+        match self.transmittance_rgb {
+            Some(c) if self.transmittance > 0.0 => c.map(|t| t / self.transmittance),
+            _ => [1.0; 3],
+        }
+    }
+
+    /// Whether this glazing changes the colour of what goes through it.
+    pub fn is_tinted(&self) -> bool {
+        self.tint() != [1.0; 3]
     }
 }
 

@@ -133,12 +133,17 @@ impl State {
             .map(|p| {
                 let m = &materials[p.material as usize];
                 // Glazing: only the 1 − T of rays that do not go through land, and they
-                // carry all its reflection (`RayCaster::with_glazing`).
+                // carry all its reflection (`RayCaster::with_glazing`). Tinted glazing lets
+                // rays through by the mean T too, so a channel it transmits less than the
+                // mean may keep more than it receives from the rays that land (ρ_c > 1 − T):
+                // not clamped, or that channel's reflection would be biased low. ρ_c + T_c ≤ 1
+                // keeps every channel's total below what it receives (docs/design.md §9).
                 let land = (1.0 - m.transmittance).max(1e-6);
+                let cap = if m.is_tinted() { f64::INFINITY } else { 1.0 };
                 PatchState {
                     unshot: m.emission().map(|x| x * p.area),
                     gathered: [0.0; 3],
-                    rho: m.rho.map(|r| (r / land).min(1.0) as f32),
+                    rho: m.rho.map(|r| (r / land).min(cap) as f32),
                     inv_area: (1.0 / p.area) as f32,
                 }
             })
@@ -270,15 +275,25 @@ impl State {
         }
     }
 
-    /// Patch j receives `scale` of every channel of a shot (`shot_ch`, per channel flux).
+    /// Patch j receives `scale` of every channel of a shot (`shot_ch`, per channel flux),
+    /// times `tint` per colour when the ray went through tinted glazing.
     #[inline]
-    pub fn deposit_channels(&mut self, j: usize, shot_ch: &[[f64; 3]], scale: f64) {
+    pub fn deposit_channels(
+        &mut self,
+        j: usize,
+        shot_ch: &[[f64; 3]],
+        scale: f64,
+        tint: Option<[f64; 3]>,
+    ) {
         if let Some(ch) = &mut self.channels {
             let rho = self.patches[j].rho;
             let k = ch.k;
             for (c, phi) in shot_ch.iter().enumerate() {
                 for (x, r) in rho.iter().enumerate() {
-                    let kept = *r as f64 * phi[x] * scale;
+                    let mut kept = *r as f64 * phi[x] * scale;
+                    if let Some(t) = tint {
+                        kept *= t[x];
+                    }
                     ch.unshot[j * k + c][x] += kept;
                     ch.gathered[j * k + c][x] += kept;
                 }
@@ -346,6 +361,17 @@ impl State {
         self.cube_gathered[j] += kept;
         self.cube_var[j] += scalar(&rho) * e_cell * kept;
         self.deposit(j, phi);
+    }
+
+    /// A ray of flux `phi` went through tinted glazing and carries `tinted` on (`phi` × the
+    /// product of the panes' T_c / T): the difference is the panes' (absorbed; negative in a
+    /// channel the tint favours, which the rays that go through less often make up on
+    /// average), so the books close per channel ray by ray (docs/design.md §9).
+    #[inline]
+    pub fn tint(&mut self, phi: &[f64; 3], tinted: &[f64; 3]) {
+        for c in 0..3 {
+            self.energy.absorbed[c] += phi[c] - tinted[c];
+        }
     }
 
     /// Flux that arrived on a back face (absorbed there).

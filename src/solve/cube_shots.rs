@@ -170,7 +170,7 @@ pub(super) fn apply(st: &mut State, shot: &CubeShot, hits: &CubeHits) {
         } else {
             st.deposit_cube(j as usize, &phi, e_cell);
             if !shot.ch.is_empty() {
-                st.deposit_channels(j as usize, &shot.ch, f);
+                st.deposit_channels(j as usize, &shot.ch, f, None);
             }
         }
         seen += f;

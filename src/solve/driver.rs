@@ -32,7 +32,7 @@ use super::cube_shots::{self, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WA
 use super::estimate::Estimator;
 use super::final_gather;
 use super::ray_shots::{
-    apply_rays, energy_per_ray, grid_for, tasks_of, RayCaster, RayShot, Task, BACK, WAVE_RAYS,
+    apply_rays, energy_per_ray, grid_for, tasks_of, Hits, RayCaster, RayShot, Task, BACK, WAVE_RAYS,
 };
 use super::sky_shots;
 use super::stopping::{self, Progress};
@@ -226,7 +226,7 @@ impl PatchScalars {
 struct Pending {
     wave: Vec<RayShot>,
     tasks: Vec<Task>,
-    hits: Vec<Vec<u32>>,
+    hits: Vec<Hits>,
 }
 
 /// One shooting solve in progress.
@@ -519,7 +519,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
     fn progress(&mut self, elapsed: f64) -> (Progress, f64) {
         let (in_flight, flying) = self.pending.as_ref().map_or((0, 0.0), |p| {
             (
-                p.hits.iter().map(Vec::len).sum::<usize>() as u64,
+                p.hits.iter().map(|h| h.codes.len()).sum::<usize>() as u64,
                 p.wave.iter().map(|s| scalar(&s.phi)).sum::<f64>(),
             )
         });
@@ -644,7 +644,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
         }
         let caster = self.caster.as_ref().expect("checked in Driver::new");
         let tasks = tasks_of(&wave);
-        let cast = || -> Vec<Vec<u32>> {
+        let cast = || -> Vec<Hits> {
             tasks
                 .par_iter()
                 .map(|t| caster.cast(&wave[t.shot], t.chunk, t.first, t.count))

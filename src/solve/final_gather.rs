@@ -132,8 +132,9 @@ struct Ctx<'a, I> {
     /// The sky that lights the model from outside (issue 14): rays that leave see it, and its
     /// sun is sampled like a light.
     sky: Option<&'a Sky>,
-    /// Straight-through transmittance per patch (glazing); empty when nothing transmits.
-    trans: Vec<f64>,
+    /// Straight-through transmittance per patch and channel T_c (glazing, tinted or grey:
+    /// docs/design.md §9); empty when nothing transmits.
+    trans: Vec<[f64; 3]>,
     /// The sky's and the sun's per-light channels, when kept.
     sky_channel: Option<usize>,
     sun_channel: Option<usize>,
@@ -155,18 +156,25 @@ pub const BIAS_Z: f64 = 4.0;
 
 /// Adds `w`·`v` to channel `c` of `ch`, when there is one.
 fn add_to(ch: &mut [[f64; 3]], c: Option<usize>, v: [f64; 3], w: f64) {
+    add_to3(ch, c, v, [w; 3]);
+}
+
+/// Adds `w`·`v` per colour to channel `c` of `ch`, when there is one (`w`: a weight per colour,
+/// as tinted glazing's transmittance).
+fn add_to3(ch: &mut [[f64; 3]], c: Option<usize>, v: [f64; 3], w: [f64; 3]) {
     if let Some(x) = c.and_then(|c| ch.get_mut(c)) {
         for q in 0..3 {
-            x[q] += w * v[q];
+            x[q] += w[q] * v[q];
         }
     }
 }
 
-/// What a ray met ([`Ctx::cast`]): the first opaque hit, the transmittance of the glazing
-/// before it, and what the panes' sides it met reflect towards it.
+/// What a ray met ([`Ctx::cast`]): the first opaque hit, the transmittance per channel of the
+/// glazing before it (the product of its panes' T_c), and what the panes' sides it met
+/// reflect towards it.
 struct Traced {
     hit: Option<crate::intersect::Hit>,
-    through: f64,
+    through: [f64; 3],
     panes: [f64; 3],
 }
 
@@ -217,7 +225,7 @@ impl<'a, I: Intersector> Ctx<'a, I> {
             .vertices
             .iter()
             .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
-        let t = |p: &crate::mesh::Patch| materials[p.material as usize].transmittance;
+        let t = |p: &crate::mesh::Patch| materials[p.material as usize].transmittance_rgb();
         let channel = |name: &str| inputs.channels.iter().position(|c| c.name == name);
         Ctx {
             mesh,
@@ -354,25 +362,34 @@ impl<I: Intersector> Ctx<'_, I> {
     ///
     /// Glazing (issue 14) is seen and seen through: each pane met adds what its side reflects
     /// (B − E, times the transmittance of the panes before it) and passes on its transmittance
-    /// T; the ray goes on to the first opaque surface.
+    /// T_c per channel (tinted glazing's colour: docs/design.md §9); the ray goes on to the
+    /// first opaque surface.
     fn cast(&self, i: usize, mut ray: Ray, eps: f32) -> Traced {
         let own = (i != NO_PATCH).then(|| self.mesh.surface_of(i));
         let mut out = Traced {
             hit: None,
-            through: 1.0,
+            through: [1.0; 3],
             panes: [0.0; 3],
         };
         for _ in 0..MAX_STEPS {
             match self.isect.intersect(&ray) {
                 Some(h) if Some(h.patch as usize) == own => ray.tnear = h.t + eps,
-                Some(h) if self.trans.get(h.patch as usize).is_some_and(|t| *t > 0.0) => {
+                Some(h)
+                    if self
+                        .trans
+                        .get(h.patch as usize)
+                        .is_some_and(|t| t.iter().any(|c| *c > 0.0)) =>
+                {
                     if let Some(r) = self.mesh.receiver(h.patch, h.back) {
                         let r = r as usize;
                         for q in 0..3 {
-                            out.panes[q] += out.through * (self.b[r][q] - self.e[r][q]).max(0.0);
+                            out.panes[q] += out.through[q] * (self.b[r][q] - self.e[r][q]).max(0.0);
                         }
                     }
-                    out.through *= self.trans[h.patch as usize];
+                    let t = self.trans[h.patch as usize];
+                    for (x, t) in out.through.iter_mut().zip(t) {
+                        *x *= t;
+                    }
                     ray.tnear = h.t + (h.t * 1e-5).max(self.eps_floor);
                 }
                 other => {
@@ -382,7 +399,7 @@ impl<I: Intersector> Ctx<'_, I> {
             }
         }
         // Lost among surfaces: nothing seen beyond.
-        out.through = 0.0;
+        out.through = [0.0; 3];
         out
     }
 
@@ -545,7 +562,7 @@ impl<I: Intersector> Ctx<'_, I> {
             if hit.is_none() {
                 sub.v = self.sky_exitance(dir);
             }
-            let val = [0, 1, 2].map(|q| seen.panes[q] + seen.through * (sub.v[q] + emitted[q]));
+            let val = [0, 1, 2].map(|q| seen.panes[q] + seen.through[q] * (sub.v[q] + emitted[q]));
             m.push(scalar(&[0, 1, 2].map(|q| rho[q] * val[q])));
             for q in 0..3 {
                 sum[q] += val[q];
@@ -555,12 +572,12 @@ impl<I: Intersector> Ctx<'_, I> {
                     let own = self.group.is_some_and(|g| g[r] as usize == c);
                     for q in 0..3 {
                         let lit = if own { emitted[q] } else { 0.0 };
-                        chc[q] += seen.through * (sub.ch[c][q] + lit) / x_count as f64;
+                        chc[q] += seen.through[q] * (sub.ch[c][q] + lit) / x_count as f64;
                     }
                 }
             } else if hit.is_none() {
-                let w = seen.through / x_count as f64;
-                add_to(&mut ch, self.sky_channel, sub.v, w);
+                let w = seen.through.map(|t| t / x_count as f64);
+                add_to3(&mut ch, self.sky_channel, sub.v, w);
             }
         }
         for q in 0..3 {
@@ -608,8 +625,11 @@ impl<I: Intersector> Ctx<'_, I> {
         if seen.hit.is_some() {
             return [0.0; 3];
         }
-        let w = seen.through * Sun::solid_angle() * f64::from(cos) * self.sun_weight;
-        sun.radiance().map(|l| l * w)
+        let w = seen
+            .through
+            .map(|t| t * Sun::solid_angle() * f64::from(cos) * self.sun_weight);
+        let l = sun.radiance();
+        [0, 1, 2].map(|q| l[q] * w[q])
     }
 
     /// The emitter (index into `emitters`) that `s` ∈ [0, 1) picks along the power CDF, its
@@ -712,9 +732,9 @@ impl<I: Intersector> Ctx<'_, I> {
             [0.0; 3]
         };
         for q in 0..3 {
-            h[q] += seen.panes[q] + w * l[q];
+            h[q] += seen.panes[q] + w[q] * l[q];
         }
-        add_to(&mut ch, self.sky_channel, l, w);
+        add_to3(&mut ch, self.sky_channel, l, w);
         if let Some(sun) = self.sky.and_then(Sky::sun) {
             rays += 1;
             let l = self.sun_sample(r, sun, x, n, eps, rng.gen(), rng.gen());
@@ -741,12 +761,12 @@ impl<I: Intersector> Ctx<'_, I> {
             let sub = self.reflected_at(s, x + dir * t2, t2, depth + 1, rng);
             rays += sub.rays;
             for q in 0..3 {
-                h[q] += w * (sub.v[q] + emitted[q]);
+                h[q] += w[q] * (sub.v[q] + emitted[q]);
             }
             for (c, chc) in ch.iter_mut().enumerate() {
                 let own = self.group.is_some_and(|g| g[s] as usize == c);
                 for q in 0..3 {
-                    chc[q] += w * (sub.ch[c][q] + if own { emitted[q] } else { 0.0 });
+                    chc[q] += w[q] * (sub.ch[c][q] + if own { emitted[q] } else { 0.0 });
                 }
             }
         }
@@ -791,13 +811,15 @@ impl<I: Intersector> Ctx<'_, I> {
             }
         };
         let g = if seen {
-            traced.through * f64::from(cos_i) * f64::from(cos_j)
-                / (std::f64::consts::PI * f64::from(dist).powi(2))
+            traced.through.map(|t| {
+                t * f64::from(cos_i) * f64::from(cos_j)
+                    / (std::f64::consts::PI * f64::from(dist).powi(2))
+            })
         } else {
-            0.0
+            [0.0; 3]
         };
         Some(Shadow {
-            e_g: self.e[j].map(|e| e * g),
+            e_g: [0, 1, 2].map(|q| self.e[j][q] * g[q]),
             cos_i: f64::from(cos_i),
             cos_j: f64::from(cos_j),
             dist: f64::from(dist),
@@ -1239,12 +1261,13 @@ pub struct ViewHit {
 }
 
 /// What a camera ray sees: the first side that faces it (backs of one-sided patches are passed
-/// through, as the Gouraud rasterizer culls them), the transmittance of the glazing before it
-/// and what the panes' sides reflect towards the camera (W/m², already weighed).
+/// through, as the Gouraud rasterizer culls them), the transmittance per channel of the glazing
+/// before it (tinted glazing colours what is seen through it: docs/design.md §9) and what the
+/// panes' sides reflect towards the camera (W/m², already weighed).
 #[derive(Clone, Copy, Debug)]
 pub struct ViewSeen {
     pub hit: Option<ViewHit>,
-    pub through: f64,
+    pub through: [f64; 3],
     pub panes: [f64; 3],
     /// Rays cast.
     pub rays: u64,
@@ -1337,7 +1360,7 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         };
         let mut out = ViewSeen {
             hit: None,
-            through: 1.0,
+            through: [1.0; 3],
             panes: [0.0; 3],
             rays: 0,
         };
@@ -1345,9 +1368,9 @@ impl<'a, I: Intersector> PointGather<'a, I> {
             let seen = ctx.cast(NO_PATCH, ray, ctx.eps_floor);
             out.rays += 1;
             for q in 0..3 {
-                out.panes[q] += out.through * seen.panes[q];
+                out.panes[q] += out.through[q] * seen.panes[q];
+                out.through[q] *= seen.through[q];
             }
-            out.through *= seen.through;
             let Some(h) = seen.hit else {
                 return out;
             };
@@ -1360,7 +1383,7 @@ impl<'a, I: Intersector> PointGather<'a, I> {
             }
             ray.tnear = h.t + (h.t * 1e-5).max(ctx.eps_floor);
         }
-        out.through = 0.0;
+        out.through = [0.0; 3];
         out
     }
 

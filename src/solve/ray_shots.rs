@@ -145,6 +145,44 @@ pub(super) struct RayCaster<'a, I> {
     /// Straight-through transmittance per patch (glazing, issue 14); empty when nothing
     /// transmits.
     trans: Vec<f32>,
+    /// The factor T_c / T per patch a ray going through it carries its energy on with
+    /// (`Material::tint`); empty when no glazing is tinted.
+    tint: Vec<[f64; 3]>,
+}
+
+/// The rays of one chunk: a hit code per ray, and which of them went through tinted glazing.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Hits {
+    pub codes: Vec<u32>,
+    /// (the ray's index in `codes`, the product of the tinted panes' T_c / T it went
+    /// through), in ray order; empty when no ray met tinted glazing.
+    pub tinted: Vec<(u32, [f64; 3])>,
+}
+
+impl Hits {
+    /// Each ray's hit code and, when it went through tinted glazing, its tint factor.
+    pub fn iter(&self) -> impl Iterator<Item = (u32, Option<[f64; 3]>)> + '_ {
+        let mut tinted = self.tinted.iter().peekable();
+        self.codes.iter().enumerate().map(move |(k, &code)| {
+            let tint = tinted.next_if(|(at, _)| *at as usize == k).map(|(_, t)| *t);
+            (code, tint)
+        })
+    }
+}
+
+/// Flux `phi` of a ray that went through tinted glazing of factor `tint` (the energy it
+/// carries on, per channel), the difference booked to the panes ([`State::tint`]); `phi`
+/// itself for every other ray.
+#[inline]
+pub(super) fn carried(st: &mut State, phi: &[f64; 3], tint: Option<[f64; 3]>) -> [f64; 3] {
+    match tint {
+        Some(t) => {
+            let out = [0, 1, 2].map(|c| phi[c] * t[c]);
+            st.tint(phi, &out);
+            out
+        }
+        None => *phi,
+    }
 }
 
 impl<'a, I: Intersector> RayCaster<'a, I> {
@@ -160,6 +198,7 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
             jitter,
             eps_floor: reach * 5e-7,
             trans: Vec::new(),
+            tint: Vec::new(),
         }
     }
 
@@ -167,16 +206,31 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
     /// unchanged with probability T (every ray keeps its energy C); the rest land on it, which
     /// keeps ρ/(1 − T) of them ([`super::books::State::new`]), so it reflects ρ of all the
     /// light it receives.
+    ///
+    /// Tinted glazing (docs/design.md §9) lets rays through with the same probability T, the
+    /// mean of its T_c, so every ray still carries the same energy C when it leaves its
+    /// shooter (Sec. 2); one that goes through carries its energy on times T_c / T per
+    /// channel, which makes each channel's transmitted light T_c of what arrives on average.
+    /// Grey glazing's factor is exactly 1, and is not applied.
     pub fn with_glazing(mut self, materials: &[crate::scene::Material]) -> Self {
-        let t = |p: &crate::mesh::Patch| materials[p.material as usize].transmittance as f32;
+        let mat = |p: &crate::mesh::Patch| &materials[p.material as usize];
+        let t = |p: &crate::mesh::Patch| mat(p).transmittance as f32;
         if self.mesh.patches.iter().any(|p| t(p) > 0.0) {
             self.trans = self.mesh.patches.iter().map(t).collect();
+        }
+        if self
+            .mesh
+            .patches
+            .iter()
+            .any(|p| t(p) > 0.0 && mat(p).is_tinted())
+        {
+            self.tint = self.mesh.patches.iter().map(|p| mat(p).tint()).collect();
         }
         self
     }
 
     /// Casts rays `first..first + count` of `shot` (its chunk `chunk`); a hit code per ray.
-    pub fn cast(&self, shot: &RayShot, chunk: usize, first: usize, count: usize) -> Vec<u32> {
+    pub fn cast(&self, shot: &RayShot, chunk: usize, first: usize, count: usize) -> Hits {
         let i = shot.patch;
         let patch = &self.mesh.patches[i];
         // Sec. 3: a random rotation of the sampling pattern about the normal, per shot.
@@ -185,18 +239,22 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         let mut rng = rng_for(self.seed, shot.index, chunk as u64);
         let eps = (1e-4 * (patch.area as f32).sqrt()).max(self.eps_floor);
         let points = PatchPoints::new(self.mesh, i);
-        let mut out = Vec::with_capacity(count);
+        let mut out = Hits {
+            codes: Vec::with_capacity(count),
+            tinted: Vec::new(),
+        };
+        // The shooter's surface: a back twin's rays leave the surface its front patch is.
+        let own = Some(self.mesh.surface_of(i));
         for k in first..first + count {
             let dir = frame.to_world(shot.grid.direction(k, 0.0, self.jitter, &mut rng));
             let org = points.sample(&mut rng) + patch.normal * eps;
-            out.push(self.cast_one(i, org, dir, eps, &mut rng));
+            let (code, tint) = self.trace(own, org, dir, eps, &mut rng);
+            if let Some(t) = tint {
+                out.tinted.push(((k - first) as u32, t));
+            }
+            out.codes.push(code);
         }
         out
-    }
-
-    fn cast_one<R: Rng>(&self, shooter: usize, org: Vec3, dir: Vec3, eps: f32, rng: &mut R) -> u32 {
-        // The shooter's surface: a back twin's rays leave the surface its front patch is.
-        self.cast_from(Some(self.mesh.surface_of(shooter)), org, dir, eps, rng)
     }
 
     /// The hit code of a ray from `org` along `dir` that starts on surface `own` (none for a
@@ -209,31 +267,53 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         eps: f32,
         rng: &mut R,
     ) -> u32 {
+        self.trace(own, org, dir, eps, rng).0
+    }
+
+    /// [`Self::cast_from`], and the factor per channel the ray's energy carries on with when
+    /// it went through tinted glazing (the product of the panes' T_c / T; `None` when it met
+    /// none).
+    pub(super) fn trace<R: Rng>(
+        &self,
+        own: Option<usize>,
+        org: Vec3,
+        dir: Vec3,
+        eps: f32,
+        rng: &mut R,
+    ) -> (u32, Option<[f64; 3]>) {
         let mut ray = Ray {
             org,
             dir,
             tnear: 0.0,
             tfar: f32::INFINITY,
         };
+        let mut tint: Option<[f64; 3]> = None;
         // A ray leaving its own (planar, convex) patch cannot meet it again; if rounding says
         // otherwise, step past it.
         for _ in 0..MAX_STEPS {
             match self.isect.intersect(&ray) {
-                None => return ESCAPED,
+                None => return (ESCAPED, tint),
                 Some(h) if Some(h.patch as usize) == own => ray.tnear = h.t + eps,
                 Some(h) if self.passes(h.patch as usize, rng) => {
+                    if let Some(f) = self.tint.get(h.patch as usize).filter(|f| **f != [1.0; 3]) {
+                        let t = tint.get_or_insert([1.0; 3]);
+                        for c in 0..3 {
+                            t[c] *= f[c];
+                        }
+                    }
                     ray.tnear = h.t + (h.t * 1e-5).max(self.eps_floor);
                 }
                 // The side met decides the receiver (docs/design.md §7).
                 Some(h) => {
-                    return self
+                    let code = self
                         .mesh
                         .receiver(h.patch, h.back)
-                        .unwrap_or(h.patch | BACK)
+                        .unwrap_or(h.patch | BACK);
+                    return (code, tint);
                 }
             }
         }
-        ESCAPED
+        (ESCAPED, tint)
     }
 
     /// Whether a ray that met `patch` goes through it (glazing).
@@ -246,7 +326,7 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
     pub fn cast_all(&self, shot: &RayShot) -> usize {
         tasks_of(std::slice::from_ref(shot))
             .iter()
-            .map(|t| self.cast(shot, t.chunk, t.first, t.count).len())
+            .map(|t| self.cast(shot, t.chunk, t.first, t.count).codes.len())
             .sum()
     }
 }
@@ -279,24 +359,26 @@ pub fn time_ray_shots<I: Intersector>(
 }
 
 /// Applies a wave's hits in task order: receivers gain ρ_j·ΔΦ_i/X, the rest is absorbed.
-pub(super) fn apply_rays(st: &mut State, wave: &[RayShot], tasks: &[Task], hits: &[Vec<u32>]) {
-    for (task, codes) in tasks.iter().zip(hits) {
+/// A ray that went through tinted glazing carries ΔΦ_i/X times its tint factor.
+pub(super) fn apply_rays(st: &mut State, wave: &[RayShot], tasks: &[Task], hits: &[Hits]) {
+    for (task, hits) in tasks.iter().zip(hits) {
         let shot = &wave[task.shot];
         let per_ray = 1.0 / shot.grid.len() as f64;
         let phi_ray = shot.phi.map(|p| p * per_ray);
-        for &code in codes {
+        for (code, tint) in hits.iter() {
+            let phi = carried(st, &phi_ray, tint);
             if code == ESCAPED {
-                st.escape(&phi_ray);
+                st.escape(&phi);
             } else if code & BACK != 0 {
-                st.deposit_back(&phi_ray);
+                st.deposit_back(&phi);
             } else {
-                st.deposit(code as usize, &phi_ray);
+                st.deposit(code as usize, &phi);
                 if !shot.ch.is_empty() {
-                    st.deposit_channels(code as usize, &shot.ch, per_ray);
+                    st.deposit_channels(code as usize, &shot.ch, per_ray, tint);
                 }
             }
         }
-        st.rays += codes.len() as u64;
+        st.rays += hits.codes.len() as u64;
     }
     st.finish_batch();
 }

@@ -25,7 +25,7 @@
 //! not a winding error).
 
 use super::books::State;
-use super::ray_shots::{RayCaster, BACK, CHUNK, ESCAPED};
+use super::ray_shots::{carried, Hits, RayCaster, BACK, CHUNK, ESCAPED};
 use super::rng_for;
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
@@ -181,27 +181,34 @@ pub(super) fn shoot<I: Intersector>(
         st.emit_distant(&phi);
         let chunks: Vec<usize> = (0..x.div_ceil(CHUNK)).collect();
         for batch in chunks.chunks(BATCH_CHUNKS) {
-            let hits: Vec<Vec<u32>> = batch
+            let hits: Vec<Hits> = batch
                 .par_iter()
                 .map(|&ch| {
                     let mut rng = rng_for(seed, SKY_STREAM, ((k as u64) << 32) | ch as u64);
-                    (ch * CHUNK..(ch * CHUNK + CHUNK).min(x))
-                        .map(|r| {
-                            let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);
-                            caster.cast_from(None, org, dir, 0.0, &mut rng)
-                        })
-                        .collect()
+                    let mut out = Hits::default();
+                    for r in ch * CHUNK..(ch * CHUNK + CHUNK).min(x) {
+                        let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);
+                        let (code, tint) = caster.trace(None, org, dir, 0.0, &mut rng);
+                        if let Some(t) = tint {
+                            out.tinted.push((out.codes.len() as u32, t));
+                        }
+                        out.codes.push(code);
+                    }
+                    out
                 })
                 .collect();
-            for code in hits.into_iter().flatten() {
+            for (code, tint) in hits.iter().flat_map(Hits::iter) {
+                // Through tinted glazing, the ray carries its energy on tinted (books: the
+                // difference is the panes').
+                let phi = carried(st, &phi_ray, tint);
                 if code == ESCAPED {
-                    st.escape_distant(&phi_ray);
+                    st.escape_distant(&phi);
                 } else if code & BACK != 0 {
-                    st.deposit_back_distant(&phi_ray);
+                    st.deposit_back_distant(&phi);
                 } else {
-                    st.deposit(code as usize, &phi_ray);
+                    st.deposit(code as usize, &phi);
                     if !shot_ch.is_empty() {
-                        st.deposit_channels(code as usize, &shot_ch, 1.0 / x as f64);
+                        st.deposit_channels(code as usize, &shot_ch, 1.0 / x as f64, tint);
                     }
                 }
             }

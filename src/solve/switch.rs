@@ -381,7 +381,7 @@ pub(super) fn probe<I: Intersector>(caster: &RayCaster<I>, patch: usize) -> f64 
             .par_iter()
             .map(|t| {
                 let t0 = Instant::now();
-                let n = caster.cast(&shot, t.chunk, t.first, t.count).len();
+                let n = caster.cast(&shot, t.chunk, t.first, t.count).codes.len();
                 (t0.elapsed().as_secs_f64(), n)
             })
             .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));

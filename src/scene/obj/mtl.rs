@@ -63,12 +63,14 @@ pub(super) fn convert_material(m: &tobj::Material) -> Result<Material, String> {
             fmt3(&ke)
         ));
     }
+    let (transmittance, transmittance_rgb) = transmittance(m)?;
     Ok(Material {
         name: m.name.clone(),
         rho,
         ke,
         rho_source,
-        transmittance: transmittance(m)?,
+        transmittance,
+        transmittance_rgb,
     })
 }
 
@@ -80,8 +82,10 @@ pub(super) fn convert_material(m: &tobj::Material) -> Result<Material, String> {
 /// - a `Tf` strictly between 0 and 1 in some channel: T = mean `Tf`;
 /// - otherwise opaque: exporters write `Tf 1 1 1` (and some `Tf 0 0 0`) on every material.
 ///
-/// The colour of `Tf` is not kept: glazing is grey (every ray carries the same energy).
-fn transmittance(m: &tobj::Material) -> Result<f64, String> {
+/// The colour of `Tf` is kept as T_c (the same rule per channel, e.g. (1 − d) × `Tf`_c) when
+/// its channels differ: tinted glazing (docs/design.md §9, "Tinted glazing"); `None` when
+/// they are equal (grey glazing, exactly as before colour was kept) or the material is opaque.
+fn transmittance(m: &tobj::Material) -> Result<(f64, Option<[f64; 3]>), String> {
     let number = |key: &str| -> Result<Option<f64>, String> {
         m.unknown_param
             .get(key)
@@ -104,11 +108,19 @@ fn transmittance(m: &tobj::Material) -> Result<f64, String> {
         None => number("Tr")?.map(|tr| 1.0 - tr),
     };
     let mean = |c: [f64; 3]| (c[0] + c[1] + c[2]) / 3.0;
-    let t = match (opacity, tf) {
-        (Some(d), _) if d < 1.0 => (1.0 - d) * tf.map_or(1.0, mean),
-        (_, Some(c)) if matches!(m.illumination_model, Some(4 | 6 | 7 | 9)) => mean(c),
-        (_, Some(c)) if c.iter().any(|x| *x > 0.0 && *x < 1.0) => mean(c),
-        _ => 0.0,
+    // The colour of `Tf` where it transmits: kept only when its channels differ.
+    let colour =
+        |c: [f64; 3], scale: f64| (c[0] != c[1] || c[1] != c[2]).then(|| c.map(|x| scale * x));
+    let (t, rgb) = match (opacity, tf) {
+        (Some(d), _) if d < 1.0 => (
+            (1.0 - d) * tf.map_or(1.0, mean),
+            tf.and_then(|c| colour(c, 1.0 - d)),
+        ),
+        (_, Some(c)) if matches!(m.illumination_model, Some(4 | 6 | 7 | 9)) => {
+            (mean(c), colour(c, 1.0))
+        }
+        (_, Some(c)) if c.iter().any(|x| *x > 0.0 && *x < 1.0) => (mean(c), colour(c, 1.0)),
+        _ => (0.0, None),
     };
     if !(0.0..=1.0).contains(&t) {
         return Err(format!(
@@ -116,7 +128,16 @@ fn transmittance(m: &tobj::Material) -> Result<f64, String> {
             m.name
         ));
     }
-    Ok(t)
+    if let Some(c) = rgb.filter(|c| c.iter().any(|x| !x.is_finite() || *x < 0.0)) {
+        return Err(format!(
+            "material '{}': its transmittance {} (from Tf, d, Tr) is negative in a channel \
+             (each channel must be within [0, 1])",
+            m.name,
+            fmt3(&c)
+        ));
+    }
+    // A pane that transmits nothing on the mean is opaque, whatever its colour.
+    Ok((t, rgb.filter(|_| t > 0.0)))
 }
 
 /// ρ = `Kd` × the mean colour of `map_Kd` where the texture loads (one warning, naming each
@@ -200,11 +221,24 @@ pub(super) fn textures_and_clamp(
     glazing(name, materials, warnings);
 }
 
-/// Glazing that would reflect and transmit more than it receives (ρ + T > 1 in a channel) is
-/// given T = 1 − max ρ, with one warning naming the materials.
+/// Glazing that would reflect and transmit more than it receives (ρ_c + T_c > 1 in a
+/// channel) transmits less, with one warning naming the materials: grey glazing is given
+/// T = 1 − max ρ (it stays grey); tinted glazing T_c = 1 − ρ_c in each channel over, and T
+/// the mean of its new colour.
 fn glazing(name: &str, materials: &mut [Material], warnings: &mut Vec<String>) {
     let mut cut = Vec::new();
     for m in materials.iter_mut().filter(|m| m.transmittance > 0.0) {
+        if let Some(rgb) = m.transmittance_rgb {
+            let room = m.rho.map(|r| (1.0 - r).max(0.0));
+            if (0..3).any(|c| rgb[c] > room[c]) {
+                let kept: [f64; 3] = [0, 1, 2].map(|c| rgb[c].min(room[c]));
+                let f = |v: [f64; 3]| format!("{:.3} {:.3} {:.3}", v[0], v[1], v[2]);
+                cut.push(format!("'{}' ({} → {})", m.name, f(rgb), f(kept)));
+                m.transmittance = (kept[0] + kept[1] + kept[2]) / 3.0;
+                m.transmittance_rgb = (m.transmittance > 0.0).then_some(kept);
+            }
+            continue;
+        }
         let room = 1.0 - m.rho.iter().copied().fold(0.0, f64::max);
         if m.transmittance > room {
             cut.push(format!(
@@ -249,6 +283,7 @@ pub(super) fn default_grey(materials: &[Material]) -> Material {
         ke: [0.0; 3],
         rho_source: RhoSource::Default,
         transmittance: 0.0,
+        transmittance_rgb: None,
     }
 }
 

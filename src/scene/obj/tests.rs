@@ -901,3 +901,91 @@ fn map_file_skips_the_options() {
         assert_eq!(map_file(value), file, "{value}");
     }
 }
+
+// ---- glazing: grey and tinted (docs/design.md §9) ----
+
+const PANE_OBJ: &str = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl glass\nf 1 2 3\n";
+
+#[test]
+fn a_tinted_tf_keeps_its_colour_and_its_mean_is_the_transmittance() {
+    let s = load_strs(
+        PANE_OBJ,
+        "newmtl glass\nKd 0.05 0.05 0.05\nTf 0.2 0.6 0.3\nillum 4\n",
+    )
+    .unwrap();
+    let m = material(&s, "glass");
+    assert_eq!(m.transmittance_rgb, Some([0.2, 0.6, 0.3]));
+    assert_eq!(m.transmittance_rgb(), [0.2, 0.6, 0.3]);
+    assert!((m.transmittance - (0.2 + 0.6 + 0.3) / 3.0).abs() < 1e-15);
+    let tint = m.tint();
+    assert!(
+        (tint[0] + tint[1] + tint[2] - 3.0).abs() < 1e-12,
+        "{tint:?}"
+    );
+    assert!((tint[1] / tint[0] - 3.0).abs() < 1e-12, "{tint:?}");
+    assert!(m.is_tinted());
+    // Dissolve scales the colour as it scales the mean.
+    let s = load_strs(PANE_OBJ, "newmtl glass\nKd 0 0 0\nTf 0.2 0.6 0.4\nd 0.5\n").unwrap();
+    let m = material(&s, "glass");
+    assert_eq!(m.transmittance_rgb, Some([0.1, 0.3, 0.2]));
+    assert!((m.transmittance - 0.2).abs() < 1e-15);
+}
+
+#[test]
+fn a_grey_tf_stays_grey_exactly() {
+    let s = load_strs(
+        PANE_OBJ,
+        "newmtl glass\nKd 0.1 0.1 0.1\nTf 0.5 0.5 0.5\nillum 4\n",
+    )
+    .unwrap();
+    let m = material(&s, "glass");
+    assert_eq!(m.transmittance, 0.5);
+    assert_eq!(m.transmittance_rgb, None);
+    assert_eq!(m.transmittance_rgb(), [0.5; 3]);
+    assert_eq!(m.tint(), [1.0; 3]);
+    assert!(!m.is_tinted());
+    // Opaque materials have no colour either.
+    let s = load_strs(PANE_OBJ, "newmtl glass\nKd 0.1 0.1 0.1\nTf 1 0.5 1\nd 1\n").unwrap();
+    let m = material(&s, "glass");
+    assert!(
+        m.transmittance > 0.0,
+        "Tf strictly between 0 and 1 in a channel transmits"
+    );
+    let s = load_strs(PANE_OBJ, "newmtl glass\nKd 0.1 0.1 0.1\nTf 0 0 0\n").unwrap();
+    let m = material(&s, "glass");
+    assert_eq!((m.transmittance, m.transmittance_rgb), (0.0, None));
+}
+
+#[test]
+fn tinted_glazing_is_cut_per_channel_where_rho_plus_t_exceeds_one() {
+    let s = load_strs(
+        PANE_OBJ,
+        "newmtl glass\nKd 0.5 0.1 0.1\nTf 0.9 0.6 0.3\nillum 4\n",
+    )
+    .unwrap();
+    let m = material(&s, "glass");
+    assert_eq!(m.transmittance_rgb, Some([0.5, 0.6, 0.3]));
+    assert!((m.transmittance - 1.4 / 3.0).abs() < 1e-15);
+    let w = s.warnings.join("\n");
+    assert!(
+        w.contains("'glass' (0.900 0.600 0.300 → 0.500 0.600 0.300)"),
+        "{w}"
+    );
+    // Grey glazing keeps the rule T ≤ 1 − max ρ, and stays grey.
+    let s = load_strs(
+        PANE_OBJ,
+        "newmtl glass\nKd 0.5 0.1 0.1\nTf 0.9 0.9 0.9\nillum 4\n",
+    )
+    .unwrap();
+    let m = material(&s, "glass");
+    assert_eq!((m.transmittance, m.transmittance_rgb), (0.5, None));
+}
+
+#[test]
+fn a_negative_tf_channel_is_an_error() {
+    let r = load_strs(
+        PANE_OBJ,
+        "newmtl glass\nKd 0 0 0\nTf -0.1 0.5 0.5\nillum 4\n",
+    );
+    assert_error(r, "test.obj", &["glass", "negative in a channel"]);
+}
