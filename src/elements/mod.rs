@@ -36,13 +36,14 @@ use std::time::Instant;
 
 pub use refine::{Rule, Test};
 
-/// Default `--element-threshold`: an element is cut while its corners differ by more than
-/// this fraction of their mean.
-pub const DEFAULT_THRESHOLD: f64 = 0.01;
+/// Default `--element-threshold` ([`Test::Midpoints`]): an element is cut while the error
+/// of its interpolation, relative to its mean and weighed by its share of its patch, exceeds
+/// this (README, "Adaptive elements": above the noise of [`DEFAULT_RAYS`]-ray corners).
+pub const DEFAULT_THRESHOLD: f64 = 0.04;
 /// Default smallest element, as a fraction of the patch size.
 pub const DEFAULT_MIN_FRACTION: f32 = 1.0 / 8.0;
 /// Default `--element-rays`: rays of each corner's gather.
-pub const DEFAULT_RAYS: usize = 64;
+pub const DEFAULT_RAYS: usize = 128;
 /// Default cap on the elements, as a multiple of the patches.
 pub const DEFAULT_MAX_FACTOR: f64 = 8.0;
 /// Below this fraction of the scene's mean radiosity, differences count as if at it (dark
@@ -56,8 +57,8 @@ pub struct ElementSettings {
     /// Refine adaptive elements after the solve (`--elements on|off`); off, the elements are
     /// the patches.
     pub enabled: bool,
-    /// `--element-threshold`: cut an element while its corners differ by more than this
-    /// fraction of their mean (Cohen 1986 Sec. 3).
+    /// `--element-threshold`: cut an element while the difference [`Test`] measures exceeds
+    /// this fraction of its corners' mean (Cohen 1986 Sec. 3).
     pub threshold: f64,
     /// `--element-min-size`: the smallest element edge (metres); `None`: the patch size / 8.
     pub min_size: Option<f32>,

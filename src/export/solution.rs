@@ -870,6 +870,64 @@ mod tests {
         }
     }
 
+    /// The bytes of `sol` as format 1 wrote them: no `SIDE` and no element sections.
+    fn as_format_1(sol: &SavedSolution) -> Vec<u8> {
+        let b = bytes(sol);
+        let mut c = Cursor::new(&b[HEADER_LEN..]);
+        let mut payload = Vec::new();
+        while !c.b.is_empty() {
+            let tag = c.arr::<4>().unwrap();
+            let len = c.u64().unwrap() as usize;
+            let body = c.take(len).unwrap();
+            if !matches!(&tag, b"SIDE" | b"EVRT" | b"EIDX" | b"ELEM" | b"EPAT" | b"EVRD") {
+                section(&mut payload, &tag, |s| s.extend_from_slice(body));
+            }
+        }
+        let mut out = b[..HEADER_LEN].to_vec();
+        out[8..12].copy_from_slice(&1u32.to_le_bytes());
+        out[16..24].copy_from_slice(&(payload.len() as u64).to_le_bytes());
+        out[24..28].copy_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+        out.extend_from_slice(&payload);
+        out
+    }
+
+    /// Format 2 keeps the sides and the elements; format 1 files still read (elements none,
+    /// every patch one-sided until `Mesh::pair_twins`).
+    #[test]
+    fn format_2_keeps_sides_and_elements_and_format_1_still_reads() {
+        let mut s = sample();
+        // A back twin for the patch, and elements: the patch cut in two triangles.
+        let mut twin = s.mesh.patches[0];
+        twin.normal = -twin.normal;
+        twin.side = Side::Back { front: 0 };
+        s.mesh.patches[0].side = Side::Front { back: 1 };
+        s.mesh.patches.push(twin);
+        s.b.push([0.5; 3]);
+        s.unshot.push([0.0; 3]);
+        s.channels[0].b.push([0.5; 3]);
+        let mut em = s.mesh.clone();
+        em.patches.truncate(1);
+        em.patches[0].side = Side::One;
+        em.patches[0].count = 3;
+        em.patch_vertices = vec![0, 1, 2, 0, 2, 3];
+        let mut second = em.patches[0];
+        second.first = 3;
+        em.patches.push(second);
+        s.elements = Some(Elements::new(em, vec![0, 0], vec![[1.0, 2.0, 3.0]; 4]));
+        let back = SavedSolution::from_bytes(Path::new("x.rad"), &bytes(&s)).unwrap();
+        assert_eq!(back, s);
+        assert_eq!(back.display().0.patches.len(), 2);
+        // As format 1: no sides, no elements, the rest the same.
+        let old = SavedSolution::from_bytes(Path::new("x.rad"), &as_format_1(&s)).unwrap();
+        assert!(old.elements.is_none());
+        assert!(old.mesh.patches.iter().all(|p| p.side == Side::One));
+        assert_eq!(old.b, s.b);
+        let mut paired = old.mesh.clone();
+        assert_eq!(paired.pair_twins(), 1);
+        assert_eq!(paired.patches, s.mesh.patches);
+        assert_eq!(old.display().0.patches.len(), 2);
+    }
+
     #[test]
     fn newer_version_and_foreign_scene() {
         let mut b = bytes(&sample());

@@ -75,8 +75,10 @@ pub struct ElementArgs {
     /// the exports and elements.csv use them. off: the elements are the patches.
     #[arg(long, value_enum, default_value_t = OnOff::On, value_name = "on|off")]
     elements: OnOff,
-    /// Cut an element while the radiosity at its corners differs by more than this fraction
-    /// of their mean.
+    /// Cut an element while the error of its interpolation (the radiosity gathered at the
+    /// points a cut would add, against what its corners interpolate there), relative to its
+    /// mean and times its share of its patch's area, exceeds this (with --element-test
+    /// corners: while its corners differ by more than this fraction of their mean).
     #[arg(long, value_name = "FRACTION", default_value_t = elements::DEFAULT_THRESHOLD, allow_negative_numbers = true)]
     element_threshold: f64,
     /// The smallest element edge, metres [default: the patch size / 8].
