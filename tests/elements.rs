@@ -56,7 +56,11 @@ fn elements_tile_each_patch_exactly() {
         );
     }
     // Every value is finite and non-negative; B per element is the mean of its corners.
-    assert!(el.vertex_b.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
+    assert!(el
+        .vertex_b
+        .iter()
+        .flatten()
+        .all(|x| x.is_finite() && *x >= 0.0));
     assert!(el.b.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
 }
 
@@ -103,12 +107,20 @@ fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
             || ((az - edge).abs() < 0.5 * min && ax < 0.6);
         if on_edge {
             near += 1;
-            assert!(p.area <= 1.01 * min * min, "element {e} at {c} is {} m²", p.area);
+            assert!(
+                p.area <= 1.01 * min * min,
+                "element {e} at {c} is {} m²",
+                p.area
+            );
         }
         // A smooth stretch of floor between the shadow and the far corner.
         if c.x > 3.0 && c.x < 3.5 && c.z > -3.5 && c.z < -3.0 {
             far += 1;
-            assert!(p.area >= 3.99 * min * min, "element {e} at {c} is {} m²", p.area);
+            assert!(
+                p.area >= 3.99 * min * min,
+                "element {e} at {c} is {} m²",
+                p.area
+            );
         }
     }
     assert!(near > 20 && far > 0, "{near} {far}");
@@ -150,7 +162,10 @@ fn elements_csv_and_the_saved_solution_carry_the_elements() {
     let header = |t: &str| t.lines().next().unwrap().to_string();
     assert_eq!(header(&elements), format!("{},patch", header(&patches)));
     let sol = SavedSolution::load(&sol_path).unwrap();
-    let el = sol.elements.as_ref().expect("the saved solution keeps its elements");
+    let el = sol
+        .elements
+        .as_ref()
+        .expect("the saved solution keeps its elements");
     assert_eq!(elements.lines().count() - 1, el.mesh.patches.len());
     assert_eq!(patches.lines().count() - 1, sol.mesh.patches.len());
     assert!(el.mesh.patches.len() > sol.mesh.patches.len());
@@ -159,7 +174,11 @@ fn elements_csv_and_the_saved_solution_carry_the_elements() {
         let cells: Vec<&str> = line.split(',').collect();
         assert_eq!(cells.last().unwrap().parse::<u32>().unwrap(), el.patch[k]);
         let b: f64 = cells[14].parse().unwrap();
-        assert!((b - el.b[k][0]).abs() <= 1e-6 * b.abs().max(1e-6), "{b} {:?}", el.b[k]);
+        assert!(
+            (b - el.b[k][0]).abs() <= 1e-6 * b.abs().max(1e-6),
+            "{b} {:?}",
+            el.b[k]
+        );
     }
     // Save → load → save: the same bytes.
     let mut again = Vec::new();

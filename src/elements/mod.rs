@@ -14,7 +14,7 @@
 //! the elements' vertex radiosities is exactly Cohen 1986's display. So the light is smooth
 //! where the patches are large and sharp where the elements are small — a better picture for
 //! fewer patches than uniform meshing (README, "Adaptive elements", measures it;
-//! docs/design.md §12).
+//! docs/design.md §11).
 //!
 //! Outputs: `elements.csv` (the columns of `patches.csv` and the element's `patch`; an
 //! element's B is the mean of its corners' radiosities, which for a quad is its bilinear
@@ -219,8 +219,8 @@ impl Elements {
                 let ids = self.mesh.patch_indices(e);
                 let mut v = [0.0; 3];
                 for (k, &id) in ids.iter().enumerate() {
-                    for c in 0..3 {
-                        v[c] += w[k] * self.vertex_b[id as usize][c] as f64;
+                    for (x, &b) in v.iter_mut().zip(&self.vertex_b[id as usize]) {
+                        *x += w[k] * b as f64;
                     }
                 }
                 return Some(v);

@@ -879,7 +879,10 @@ mod tests {
             let tag = c.arr::<4>().unwrap();
             let len = c.u64().unwrap() as usize;
             let body = c.take(len).unwrap();
-            if !matches!(&tag, b"SIDE" | b"EVRT" | b"EIDX" | b"ELEM" | b"EPAT" | b"EVRD") {
+            if !matches!(
+                &tag,
+                b"SIDE" | b"EVRT" | b"EIDX" | b"ELEM" | b"EPAT" | b"EVRD"
+            ) {
                 section(&mut payload, &tag, |s| s.extend_from_slice(body));
             }
         }
