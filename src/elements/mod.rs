@@ -6,7 +6,7 @@
 //! parametric domain ([`geometry`]: quads into four at their edge midpoints, triangles into
 //! four similar ones, n-gons fan-triangulated first), and an element is cut again while the
 //! radiosity at its corners differs by more than a threshold — shadow boundaries, corners,
-//! beside lights — down to a minimum size ([`refine`]). The corners' radiosity is gathered at
+//! beside lights — down to a minimum size ([`refine`](mod@refine)). The corners' radiosity is gathered at
 //! the corner itself, with the patch solution as the cache of the indirect light
 //! ([`crate::solve::final_gather::PointGather`], in place of Cohen 1986's vertex hemi-cubes).
 //! Unshot energy stays on the patches: the elements move no energy, and the energy books are
@@ -280,7 +280,7 @@ pub fn refine<I: Intersector>(
     (el, stats)
 }
 
-/// [`refine`] by any [`Rule`] (the uniform meshing it is measured against), with `rays` per
+/// [`refine()`] by any [`Rule`] (the uniform meshing it is measured against), with `rays` per
 /// corner and at most `cap` elements.
 pub fn refine_by<I: Intersector>(
     mesh: &Mesh,
