@@ -282,7 +282,7 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
                 rays: element_rays,
                 reference_rays,
             };
-            bench_elements(scene, scene_args, solve_args, job, out)
+            bench_elements(scene, scene_args, job, out)
         }
     }
 }
@@ -290,7 +290,6 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
 fn bench_elements(
     scene: Option<PathBuf>,
     scene_args: SceneArgs,
-    solve_args: SolverArgs,
     job: radiosity::bench::elements::ElementBenchJob,
     out: Option<PathBuf>,
 ) -> Result<(), radiosity::Error> {
@@ -305,7 +304,6 @@ fn bench_elements(
             "--thresholds must be positive fractions and --reference-rays at least 2".into(),
         ));
     }
-    let _ = solve_args;
     let model =
         radiosity::model::Model::load(&source(scene), &scene_args.load(), &scene_args.mesh())?;
     let r = radiosity::bench::elements::run(&model, &job, &mut |l: &str| eprintln!("{l}"))?;
