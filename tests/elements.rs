@@ -206,6 +206,24 @@ fn elements_csv_and_the_saved_solution_carry_the_elements() {
     );
 }
 
+/// `--elements auto` (the default) refines meshes up to `AUTO_MAX_PATCHES`; `on`, any.
+#[test]
+fn elements_auto_stops_at_its_patch_limit() {
+    let auto = ElementSettings::default();
+    assert!(auto.applies_to(elements::AUTO_MAX_PATCHES as usize));
+    assert!(!auto.applies_to(elements::AUTO_MAX_PATCHES as usize + 1));
+    let on = ElementSettings {
+        auto_limit: None,
+        ..Default::default()
+    };
+    assert!(on.applies_to(usize::MAX));
+    let off = ElementSettings {
+        enabled: false,
+        ..Default::default()
+    };
+    assert!(!off.applies_to(1));
+}
+
 #[test]
 fn element_flags_are_checked() {
     let dir = tempfile::tempdir().unwrap();

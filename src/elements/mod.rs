@@ -46,6 +46,10 @@ pub const DEFAULT_MIN_FRACTION: f32 = 1.0 / 8.0;
 pub const DEFAULT_RAYS: usize = 128;
 /// Default cap on the elements, as a multiple of the patches.
 pub const DEFAULT_MAX_FACTOR: f64 = 8.0;
+/// `--elements auto` (the default) refines the elements of meshes up to this many patches
+/// and skips them, with a line, above: their cost grows with the patches (3.6 s for the
+/// 5,267-patch church on 2 cores), so a million-patch building would spend minutes on them.
+pub const AUTO_MAX_PATCHES: u64 = 200_000;
 /// Below this fraction of the scene's mean radiosity, differences count as if at it (dark
 /// corners are not refined for noise).
 pub const FLOOR: f64 = 1e-3;
@@ -54,9 +58,11 @@ pub const FLOOR: f64 = 1e-3;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ElementSettings {
-    /// Refine adaptive elements after the solve (`--elements on|off`); off, the elements are
-    /// the patches.
+    /// Refine adaptive elements after the solve (`--elements auto|on|off`); off, the elements
+    /// are the patches.
     pub enabled: bool,
+    /// `--elements auto`: refine only meshes of at most this many patches (`None`: any).
+    pub auto_limit: Option<u64>,
     /// `--element-threshold`: cut an element while the difference [`Test`] measures exceeds
     /// this fraction of its corners' mean (Cohen 1986 Sec. 3).
     pub threshold: f64,
@@ -75,6 +81,7 @@ impl Default for ElementSettings {
     fn default() -> Self {
         ElementSettings {
             enabled: true,
+            auto_limit: Some(AUTO_MAX_PATCHES),
             threshold: DEFAULT_THRESHOLD,
             min_size: None,
             rays: DEFAULT_RAYS,
@@ -114,6 +121,11 @@ impl ElementSettings {
             ));
         }
         Ok(())
+    }
+
+    /// Whether to refine the elements of a mesh of `patches` patches.
+    pub fn applies_to(&self, patches: usize) -> bool {
+        self.enabled && self.auto_limit.is_none_or(|n| patches as u64 <= n)
     }
 
     /// The smallest element edge for patches of size `patch_size`.

@@ -93,7 +93,15 @@ pub fn write(
     // The elements and the gathered picture cast rays: through the solve's intersector, or
     // one built for them (the methods that cast none).
     let built;
-    let needs_rays = job.settings.elements.enabled || job.shading.shading == Shading::Gather;
+    let refine = job.settings.elements.applies_to(m.patches.len());
+    if job.settings.elements.enabled && !refine {
+        log(&format!(
+            "elements: skipped for {} patches (--elements auto refines up to {}; --elements on to refine anyway)",
+            m.patches.len(),
+            elements::AUTO_MAX_PATCHES
+        ));
+    }
+    let needs_rays = refine || job.shading.shading == Shading::Gather;
     let isect = match run.isect {
         Some((i, _)) => Some(i),
         None if needs_rays => {
@@ -103,7 +111,7 @@ pub fn write(
         None => None,
     };
     let (elements, element_stats) = match isect {
-        Some(isect) if job.settings.elements.enabled => {
+        Some(isect) if refine => {
             run.progress.phase("refining elements");
             let gather = crate::solve::final_gather::PointGather::new(
                 m,
@@ -121,7 +129,7 @@ pub fn write(
                 job.settings.solve.seed,
             );
             log(&format!(
-                "elements: {} from {} patches (threshold {}, min size {} m), {} rays, {:.2} s",
+                "elements: {} from {} patches (threshold {}, min size {:.4} m), {} rays, {:.2} s",
                 st.count, st.patches, st.threshold, st.min_size, st.rays, st.seconds
             ));
             if st.capped {

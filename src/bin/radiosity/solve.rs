@@ -1,6 +1,6 @@
 //! `radiosity solve`.
 
-use crate::args::{source, LightGroupsArg, OnOff, SceneArgs, ShadingArgs, SolverArgs, ViewArgs};
+use crate::args::{source, LightGroupsArg, SceneArgs, ShadingArgs, SolverArgs, ViewArgs};
 use crate::sky_args::SkyArgs;
 use crate::{interrupt_flag, outln};
 use clap::Args;
@@ -72,9 +72,10 @@ pub struct SolveArgs {
 pub struct ElementArgs {
     /// After the solve, cut each patch into elements where its light changes (shadow edges,
     /// corners, beside lights), each corner's radiosity gathered with rays; the picture,
-    /// the exports and elements.csv use them. off: the elements are the patches.
-    #[arg(long, value_enum, default_value_t = OnOff::On, value_name = "on|off")]
-    elements: OnOff,
+    /// the exports and elements.csv use them. auto: on for meshes of up to 200,000 patches;
+    /// off: the elements are the patches.
+    #[arg(long, value_enum, default_value_t = ElementsArg::Auto, value_name = "auto|on|off")]
+    elements: ElementsArg,
     /// Cut an element while the error of its interpolation (the radiosity gathered at the
     /// points a cut would add, against what its corners interpolate there), relative to its
     /// mean and times its share of its patch's area, exceeds this (with --element-test
@@ -97,6 +98,14 @@ pub struct ElementArgs {
     element_test: ElementTestArg,
 }
 
+/// `--elements`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ElementsArg {
+    Auto,
+    On,
+    Off,
+}
+
 /// `--element-test`: see `radiosity::elements::Test`.
 #[derive(Clone, Copy, clap::ValueEnum)]
 pub enum ElementTestArg {
@@ -116,7 +125,8 @@ impl From<ElementTestArg> for elements::Test {
 impl ElementArgs {
     fn settings(&self) -> elements::ElementSettings {
         elements::ElementSettings {
-            enabled: self.elements == OnOff::On,
+            enabled: self.elements != ElementsArg::Off,
+            auto_limit: (self.elements == ElementsArg::Auto).then_some(elements::AUTO_MAX_PATCHES),
             threshold: self.element_threshold,
             min_size: self.element_min_size,
             rays: self.element_rays,
