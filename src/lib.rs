@@ -26,6 +26,7 @@
 
 pub mod bench;
 pub mod compare;
+pub mod elements;
 pub mod error;
 pub mod export;
 pub mod generate;

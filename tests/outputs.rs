@@ -214,6 +214,10 @@ fn a_uniformly_lit_closed_box_renders_flat_at_e_over_one_minus_rho() {
     let mut exact = SavedSolution::load(&sol).unwrap();
     exact.b.iter_mut().for_each(|b| *b = [FURNACE_B as f64; 3]);
     exact.vertex_b = exact.mesh.vertex_values(&exact.b);
+    if let Some(e) = &mut exact.elements {
+        e.vertex_b.iter_mut().for_each(|v| *v = [FURNACE_B; 3]);
+        e.b.iter_mut().for_each(|b| *b = [FURNACE_B as f64; 3]);
+    }
     let exact_path = dir.path().join("exact.rad");
     let mut bytes = Vec::new();
     exact.write(&mut bytes).unwrap();
@@ -243,8 +247,11 @@ fn exports_read_back_with_vertex_counts_and_colour_ranges() {
     let dir = tempfile::tempdir().unwrap();
     let sol_path = solve_default(dir.path());
     let sol = SavedSolution::load(&sol_path).unwrap();
-    let n = sol.mesh.vertices.len();
-    let b_max = sol.vertex_b.iter().flatten().fold(0.0f32, |a, &b| a.max(b));
+    // Exports draw the elements (issue 15): the element mesh and its vertex radiosities.
+    let (emesh, vertex_b) = sol.display();
+    assert!(sol.elements.is_some());
+    let n = emesh.vertices.len();
+    let b_max = vertex_b.iter().flatten().fold(0.0f32, |a, &b| a.max(b));
 
     // PLY, through the crate's own reader.
     let ply_path = dir.path().join("m.ply");
@@ -259,10 +266,10 @@ fn exports_read_back_with_vertex_counts_and_colour_ranges() {
     );
     let verts = &ply.payload["vertex"];
     assert_eq!(verts.len(), n);
-    assert_eq!(ply.payload["face"].len(), sol.mesh.patches.len());
+    assert_eq!(ply.payload["face"].len(), emesh.patches.len());
     use ply_rs_bw::ply::Property;
     let (mut max_red, mut max_lin) = (0u8, 0.0f32);
-    for (v, want) in verts.iter().zip(&sol.vertex_b) {
+    for (v, want) in verts.iter().zip(vertex_b) {
         for (k, name) in ["radiosity_r", "radiosity_g", "radiosity_b"]
             .iter()
             .enumerate()
@@ -293,7 +300,7 @@ fn exports_read_back_with_vertex_counts_and_colour_ranges() {
     let reader = prim.reader(|_| Some(&blob[..]));
     let pos: Vec<[f32; 3]> = reader.read_positions().unwrap().collect();
     assert_eq!(pos.len(), n);
-    assert_eq!(pos[0], sol.mesh.vertices[0].to_array());
+    assert_eq!(pos[0], emesh.vertices[0].to_array());
     let normals: Vec<[f32; 3]> = reader.read_normals().unwrap().collect();
     assert!(normals
         .iter()
@@ -303,8 +310,8 @@ fn exports_read_back_with_vertex_counts_and_colour_ranges() {
     assert!(colours.iter().flatten().all(|c| (0.0..=1.0).contains(c)));
     assert!(colours.iter().flatten().any(|c| *c > 0.5));
     let tris = reader.read_indices().unwrap().into_u32().count();
-    let expected: usize = (0..sol.mesh.patches.len())
-        .map(|i| 3 * (sol.mesh.patch_indices(i).len() - 2))
+    let expected: usize = (0..emesh.patches.len())
+        .map(|i| 3 * (emesh.patch_indices(i).len() - 2))
         .sum();
     assert_eq!(tris, expected);
     assert!(prim.material().unlit());

@@ -206,6 +206,11 @@ fn hallway_matches_its_readme_row_and_is_closed() {
 }
 
 #[test]
+fn spot_matches_its_readme_row_and_is_closed() {
+    check_scene("spot.obj");
+}
+
+#[test]
 fn church_matches_its_readme_row_and_is_closed() {
     check_scene("church.obj");
 }

@@ -53,6 +53,11 @@ fn furnace(dir: &Path) -> (PathBuf, PathBuf) {
     let b = f64::from(FURNACE_L) * std::f64::consts::PI;
     exact.b.iter_mut().for_each(|x| *x = [b; 3]);
     exact.vertex_b = exact.mesh.vertex_values(&exact.b);
+    // The elements (what Gouraud pictures draw) too.
+    if let Some(e) = &mut exact.elements {
+        e.vertex_b.iter_mut().for_each(|v| *v = [b as f32; 3]);
+        e.b.iter_mut().for_each(|x| *x = [b; 3]);
+    }
     let exact_path = dir.join("exact.rad");
     let mut bytes = Vec::new();
     exact.write(&mut bytes).unwrap();

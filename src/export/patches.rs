@@ -35,6 +35,9 @@ pub fn lux(m: &Material, b: &[f64; 3]) -> Option<f64> {
         .filter(|h| h.is_finite())
 }
 
+/// The column [`write_elements`] adds: the id of the element's patch.
+pub const PATCH_COLUMN: &str = "patch";
+
 /// Writes the table. `sky_lux` is the sky's unobstructed horizontal illuminance (sun
 /// included) when there is a sky, for the daylight factor. Non-finite values never reach the
 /// file: they are an error.
@@ -45,7 +48,40 @@ pub fn write(
     b: &[[f64; 3]],
     sky_lux: Option<f64>,
 ) -> io::Result<()> {
-    writeln!(w, "{HEADER},{DAYLIGHT_COLUMNS}")?;
+    write_rows(w, mesh, materials, b, sky_lux, None)
+}
+
+/// The element table `elements.csv` ([`crate::elements`]): the columns of the patch table,
+/// one row per element of the element mesh `mesh`, and last [`PATCH_COLUMN`], the id of the
+/// patch (a row of `patches.csv`) the element was cut from.
+pub fn write_elements(
+    w: &mut dyn Write,
+    mesh: &Mesh,
+    materials: &[Material],
+    b: &[[f64; 3]],
+    sky_lux: Option<f64>,
+    patch: &[u32],
+) -> io::Result<()> {
+    if patch.len() != mesh.patches.len() || b.len() != mesh.patches.len() {
+        return Err(io::Error::other(
+            "element arrays do not match the element mesh (internal error)",
+        ));
+    }
+    write_rows(w, mesh, materials, b, sky_lux, Some(patch))
+}
+
+fn write_rows(
+    w: &mut dyn Write,
+    mesh: &Mesh,
+    materials: &[Material],
+    b: &[[f64; 3]],
+    sky_lux: Option<f64>,
+    parent: Option<&[u32]>,
+) -> io::Result<()> {
+    match parent {
+        Some(_) => writeln!(w, "{HEADER},{DAYLIGHT_COLUMNS},{PATCH_COLUMN}")?,
+        None => writeln!(w, "{HEADER},{DAYLIGHT_COLUMNS}")?,
+    }
     for (i, p) in mesh.patches.iter().enumerate() {
         let m = &materials[p.material as usize];
         let e = m.emission();
@@ -81,7 +117,11 @@ pub fn write(
             .zip(sky_lux.filter(|s| *s > 0.0))
             .map(|(l, s)| 100.0 * l / s);
         let opt = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
-        writeln!(w, ",{},{}", opt(lx), opt(df))?;
+        write!(w, ",{},{}", opt(lx), opt(df))?;
+        match parent {
+            Some(pa) => writeln!(w, ",{}", pa[i])?,
+            None => writeln!(w)?,
+        }
     }
     Ok(())
 }

@@ -16,6 +16,17 @@
 //! | `UNSH` | unshot flux ΔΦ per patch, f64 × 3 (W) |
 //! | `VRAD` | radiosity at the welded vertices (the area-weighted mean of their patches), f32 × 3 |
 //! | `LCHN` | per-light channels: u32 count, then each a u32-length name and f64 × 3 per patch (may be empty) |
+//! | `SIDE` | per patch: side (u8: 0 one-sided, 1 front, 2 back twin), the other side's patch id (u32; 0 when one-sided) — format 2 |
+//! | `EVRT` | the element mesh's welded vertex positions, f32 × 3 each — format 2 |
+//! | `EIDX` | element vertex indices back to back, u32 each — format 2 |
+//! | `ELEM` | per element: a record as in `PTCH` (on `EVRT`/`EIDX`) — format 2 |
+//! | `EPAT` | per element: the id of its patch, u32 — format 2 |
+//! | `EVRD` | radiosity at the element vertices (gathered, [`crate::elements`]), f32 × 3 — format 2 |
+//!
+//! **Versions.** Format 2 added the element mesh (`EVRT`, `EIDX`, `ELEM`, `EPAT`, `EVRD`: all
+//! or none) and the patches' sides (`SIDE`). A format-1 file still reads: its elements are its
+//! patches, and its sides are found again by [`Mesh::pair_twins`]. A file newer than
+//! [`FORMAT_VERSION`] is refused with one line that says so.
 //!
 //! **Why hand-written rather than serde + a binary crate.** The file must stay readable by
 //! later versions of this tool and by other tools; a layout defined here, in one table, does
@@ -32,6 +43,7 @@
 //! invalidating the patches. A command given both a scene and a solution refuses a solution
 //! whose hash differs ([`SavedSolution::check_scene`]).
 
+use crate::elements::Elements;
 use crate::mesh::{Axis, Mesh, Patch, PatchClass, Side};
 use crate::scene::Scene;
 use glam::Vec3;
@@ -42,7 +54,7 @@ use std::path::{Path, PathBuf};
 /// The first eight bytes of every solution file.
 pub const MAGIC: [u8; 8] = *b"RADSOL\0\x1a";
 /// The format this build writes, and the newest it reads.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 /// File extension by convention.
 pub const EXTENSION: &str = "rad";
 const HEADER_LEN: usize = 32;
@@ -126,6 +138,9 @@ pub struct SavedSolution {
     pub vertex_b: Vec<[f32; 3]>,
     /// Per-light channels; empty when the solve did not keep them.
     pub channels: Vec<LightChannel>,
+    /// The adaptive elements (format 2); `None` in a format-1 file, or after relighting (the
+    /// elements' gathered values are the saved lights'): the patches are shown then.
+    pub elements: Option<Elements>,
 }
 
 /// A solution file that cannot be used. Each says which file and what is wrong, in one line.
@@ -210,6 +225,15 @@ pub fn scene_hash(scene: &Scene, patch_size: f32, two_sided: bool) -> u64 {
 }
 
 impl SavedSolution {
+    /// What is shown and exported: the element mesh and its vertex radiosities, else the
+    /// patches and theirs.
+    pub fn display(&self) -> (&Mesh, &[[f32; 3]]) {
+        match &self.elements {
+            Some(e) => (&e.mesh, &e.vertex_b),
+            None => (&self.mesh, &self.vertex_b),
+        }
+    }
+
     /// Irradiance per patch (W/m²), `None` where the material reflects nothing.
     pub fn irradiance(&self) -> Vec<Option<f64>> {
         let sol = self;
@@ -267,6 +291,7 @@ impl SavedSolution {
             &self.unshot,
             &self.vertex_b,
             &self.channels,
+            self.elements.as_ref(),
         )
     }
 
@@ -336,6 +361,7 @@ impl SavedSolution {
 }
 
 /// Writes a solution from its parts (so a solve need not copy its mesh to save it).
+#[allow(clippy::too_many_arguments)]
 pub fn write(
     w: &mut dyn Write,
     meta: &SolutionMeta,
@@ -344,7 +370,21 @@ pub fn write(
     unshot: &[[f64; 3]],
     vertex_b: &[[f32; 3]],
     channels: &[LightChannel],
+    elements: Option<&Elements>,
 ) -> io::Result<()> {
+    if let Some(e) = elements {
+        if e.patch.len() != e.mesh.patches.len()
+            || e.vertex_b.len() != e.mesh.vertices.len()
+            || e.patch.iter().any(|&p| p as usize >= mesh.patches.len())
+        {
+            return Err(io::Error::other(
+                "the elements do not match their mesh (internal error)",
+            ));
+        }
+        if !e.vertex_b.iter().flatten().all(|x| x.is_finite()) {
+            return Err(io::Error::other("the elements have a non-finite value"));
+        }
+    }
     let n = mesh.patches.len();
     if b.len() != n || unshot.len() != n || vertex_b.len() != mesh.vertices.len() {
         return Err(io::Error::other(
@@ -377,22 +417,7 @@ pub fn write(
             s.extend_from_slice(&i.to_le_bytes());
         }
     });
-    section(&mut p, b"PTCH", |s| {
-        for q in &mesh.patches {
-            for v in [q.first, q.count, q.material, q.polygon] {
-                s.extend_from_slice(&v.to_le_bytes());
-            }
-            s.extend_from_slice(&q.area.to_le_bytes());
-            put_f32s(s, &q.centre.to_array());
-            put_f32s(s, &q.normal.to_array());
-            s.push(match q.class {
-                PatchClass::Axial(Axis::X) => 0,
-                PatchClass::Axial(Axis::Y) => 1,
-                PatchClass::Axial(Axis::Z) => 2,
-                PatchClass::Skew => 3,
-            });
-        }
-    });
+    section(&mut p, b"PTCH", |s| put_records(s, &mesh.patches));
     section(&mut p, b"BRAD", |s| b.iter().for_each(|v| put_f64s(s, v)));
     section(&mut p, b"UNSH", |s| {
         unshot.iter().for_each(|v| put_f64s(s, v))
@@ -408,6 +433,38 @@ pub fn write(
             c.b.iter().for_each(|v| put_f64s(s, v));
         }
     });
+    section(&mut p, b"SIDE", |s| {
+        for q in &mesh.patches {
+            let (kind, other) = match q.side {
+                Side::One => (0u8, 0u32),
+                Side::Front { back } => (1, back),
+                Side::Back { front } => (2, front),
+            };
+            s.push(kind);
+            s.extend_from_slice(&other.to_le_bytes());
+        }
+    });
+    if let Some(e) = elements {
+        section(&mut p, b"EVRT", |s| {
+            for v in &e.mesh.vertices {
+                put_f32s(s, &v.to_array());
+            }
+        });
+        section(&mut p, b"EIDX", |s| {
+            for &i in &e.mesh.patch_vertices {
+                s.extend_from_slice(&i.to_le_bytes());
+            }
+        });
+        section(&mut p, b"ELEM", |s| put_records(s, &e.mesh.patches));
+        section(&mut p, b"EPAT", |s| {
+            for &i in &e.patch {
+                s.extend_from_slice(&i.to_le_bytes());
+            }
+        });
+        section(&mut p, b"EVRD", |s| {
+            e.vertex_b.iter().for_each(|v| put_f32s(s, v))
+        });
+    }
 
     let mut hdr = Vec::with_capacity(HEADER_LEN);
     hdr.extend_from_slice(&MAGIC);
@@ -418,6 +475,47 @@ pub fn write(
     hdr.extend_from_slice(&0u32.to_le_bytes());
     w.write_all(&hdr)?;
     w.write_all(&p)
+}
+
+/// Patch (or element) records as the `PTCH` section keeps them.
+fn put_records(s: &mut Vec<u8>, patches: &[Patch]) {
+    for q in patches {
+        for v in [q.first, q.count, q.material, q.polygon] {
+            s.extend_from_slice(&v.to_le_bytes());
+        }
+        s.extend_from_slice(&q.area.to_le_bytes());
+        put_f32s(s, &q.centre.to_array());
+        put_f32s(s, &q.normal.to_array());
+        s.push(match q.class {
+            PatchClass::Axial(Axis::X) => 0,
+            PatchClass::Axial(Axis::Y) => 1,
+            PatchClass::Axial(Axis::Z) => 2,
+            PatchClass::Skew => 3,
+        });
+    }
+}
+
+/// Reads records written by [`put_records`] (one-sided).
+fn read_records(s: &[u8], tag: &str) -> Result<Vec<Patch>, String> {
+    records(s, PATCH_RECORD, tag, |c| {
+        Some(Patch {
+            first: c.u32()?,
+            count: c.u32()?,
+            material: c.u32()?,
+            polygon: c.u32()?,
+            area: c.f64()?,
+            centre: Vec3::from_array(c.f32x3()?),
+            normal: Vec3::from_array(c.f32x3()?),
+            class: match c.u8()? {
+                0 => PatchClass::Axial(Axis::X),
+                1 => PatchClass::Axial(Axis::Y),
+                2 => PatchClass::Axial(Axis::Z),
+                3 => PatchClass::Skew,
+                _ => return None,
+            },
+            side: Side::One,
+        })
+    })
 }
 
 fn section(out: &mut Vec<u8>, tag: &[u8; 4], fill: impl FnOnce(&mut Vec<u8>)) {
@@ -521,27 +619,28 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
         c.f32x3().map(Vec3::from_array)
     })?;
     let patch_vertices = records(get(b"PIDX")?, 4, "PIDX", |c| c.u32())?;
-    let patches = records(get(b"PTCH")?, PATCH_RECORD, "PTCH", |c| {
-        Some(Patch {
-            first: c.u32()?,
-            count: c.u32()?,
-            material: c.u32()?,
-            polygon: c.u32()?,
-            area: c.f64()?,
-            centre: Vec3::from_array(c.f32x3()?),
-            normal: Vec3::from_array(c.f32x3()?),
-            class: match c.u8()? {
-                0 => PatchClass::Axial(Axis::X),
-                1 => PatchClass::Axial(Axis::Y),
-                2 => PatchClass::Axial(Axis::Z),
-                3 => PatchClass::Skew,
-                _ => return None,
-            },
-            // The file keeps no twins (§7); `Mesh::pair_twins` finds them again for a
-            // picture that casts rays into the solution (`render --shading gather`).
-            side: Side::One,
-        })
-    })?;
+    // Without a SIDE section (format 1) every patch reads one-sided; `Mesh::pair_twins`
+    // finds the twins again for a picture that casts rays into the solution.
+    let mut patches = read_records(get(b"PTCH")?, "PTCH")?;
+    if let Some(sides) = sections.get(b"SIDE") {
+        let sides = records(sides, 5, "SIDE", |c| Some((c.u8()?, c.u32()?)))?;
+        if sides.len() != patches.len() {
+            return Err("section SIDE does not match the patches".into());
+        }
+        for (i, &(kind, other)) in sides.iter().enumerate() {
+            let twin = |want: u8| {
+                sides
+                    .get(other as usize)
+                    .is_some_and(|&(k, o)| k == want && o as usize == i)
+            };
+            patches[i].side = match kind {
+                0 => Side::One,
+                1 if twin(2) => Side::Front { back: other },
+                2 if twin(1) => Side::Back { front: other },
+                _ => return Err("section SIDE has a bad side".into()),
+            };
+        }
+    }
     let b = records(get(b"BRAD")?, 24, "BRAD", |c| c.f64x3())?;
     let unshot = records(get(b"UNSH")?, 24, "UNSH", |c| c.f64x3())?;
     let vertex_b = records(get(b"VRAD")?, 12, "VRAD", |c| c.f32x3())?;
@@ -555,6 +654,29 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
         patches,
         patch_size: meta.patch_size,
     };
+    let elements = match sections.get(b"ELEM") {
+        None => None,
+        Some(el) => {
+            let emesh = Mesh {
+                vertices: records(get(b"EVRT")?, 12, "EVRT", |c| {
+                    c.f32x3().map(Vec3::from_array)
+                })?,
+                patch_vertices: records(get(b"EIDX")?, 4, "EIDX", |c| c.u32())?,
+                patches: read_records(el, "ELEM")?,
+                patch_size: meta.patch_size,
+            };
+            let patch = records(get(b"EPAT")?, 4, "EPAT", |c| c.u32())?;
+            let vb = records(get(b"EVRD")?, 12, "EVRD", |c| c.f32x3())?;
+            check_elements(
+                &emesh,
+                &patch,
+                &vb,
+                mesh.patches.len(),
+                meta.materials.len(),
+            )?;
+            Some(Elements::new(emesh, patch, vb))
+        }
+    };
     let sol = SavedSolution {
         meta,
         mesh,
@@ -562,6 +684,7 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
         unshot,
         vertex_b,
         channels,
+        elements,
     };
     check_consistent(&sol)?;
     Ok(sol)
@@ -583,6 +706,38 @@ fn parse_channels(s: &[u8], patches: usize) -> Result<Vec<LightChannel>, String>
         out.push(LightChannel { name, b });
     }
     Ok(out)
+}
+
+/// The element sections agree with each other and with the patches.
+fn check_elements(
+    m: &Mesh,
+    patch: &[u32],
+    vb: &[[f32; 3]],
+    patches: usize,
+    materials: usize,
+) -> Result<(), String> {
+    if patch.len() != m.patches.len() || vb.len() != m.vertices.len() {
+        return Err("element counts differ".into());
+    }
+    if patch.iter().any(|&p| p as usize >= patches) {
+        return Err("an element's patch is out of range".into());
+    }
+    for p in &m.patches {
+        let end = p.first as u64 + p.count as u64;
+        if p.count < 3 || end > m.patch_vertices.len() as u64 || p.material as usize >= materials {
+            return Err("an element record is out of range".into());
+        }
+    }
+    if m.patch_vertices
+        .iter()
+        .any(|&i| i as usize >= m.vertices.len())
+    {
+        return Err("an element vertex index is out of range".into());
+    }
+    if !vb.iter().flatten().all(|x| x.is_finite()) || !m.vertices.iter().all(|v| v.is_finite()) {
+        return Err("an element value is not finite".into());
+    }
+    Ok(())
 }
 
 /// Counts agree, indices are in range, numbers are finite: what the renderer and exporters
@@ -690,6 +845,7 @@ mod tests {
                 name: "m".into(),
                 b: vec![[1.0, 2.0, 3.0]],
             }],
+            elements: None,
         }
     }
 
@@ -733,6 +889,67 @@ mod tests {
                 assert_eq!(s, sample());
             }
         }
+    }
+
+    /// The bytes of `sol` as format 1 wrote them: no `SIDE` and no element sections.
+    fn as_format_1(sol: &SavedSolution) -> Vec<u8> {
+        let b = bytes(sol);
+        let mut c = Cursor::new(&b[HEADER_LEN..]);
+        let mut payload = Vec::new();
+        while !c.b.is_empty() {
+            let tag = c.arr::<4>().unwrap();
+            let len = c.u64().unwrap() as usize;
+            let body = c.take(len).unwrap();
+            if !matches!(
+                &tag,
+                b"SIDE" | b"EVRT" | b"EIDX" | b"ELEM" | b"EPAT" | b"EVRD"
+            ) {
+                section(&mut payload, &tag, |s| s.extend_from_slice(body));
+            }
+        }
+        let mut out = b[..HEADER_LEN].to_vec();
+        out[8..12].copy_from_slice(&1u32.to_le_bytes());
+        out[16..24].copy_from_slice(&(payload.len() as u64).to_le_bytes());
+        out[24..28].copy_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+        out.extend_from_slice(&payload);
+        out
+    }
+
+    /// Format 2 keeps the sides and the elements; format 1 files still read (elements none,
+    /// every patch one-sided until `Mesh::pair_twins`).
+    #[test]
+    fn format_2_keeps_sides_and_elements_and_format_1_still_reads() {
+        let mut s = sample();
+        // A back twin for the patch, and elements: the patch cut in two triangles.
+        let mut twin = s.mesh.patches[0];
+        twin.normal = -twin.normal;
+        twin.side = Side::Back { front: 0 };
+        s.mesh.patches[0].side = Side::Front { back: 1 };
+        s.mesh.patches.push(twin);
+        s.b.push([0.5; 3]);
+        s.unshot.push([0.0; 3]);
+        s.channels[0].b.push([0.5; 3]);
+        let mut em = s.mesh.clone();
+        em.patches.truncate(1);
+        em.patches[0].side = Side::One;
+        em.patches[0].count = 3;
+        em.patch_vertices = vec![0, 1, 2, 0, 2, 3];
+        let mut second = em.patches[0];
+        second.first = 3;
+        em.patches.push(second);
+        s.elements = Some(Elements::new(em, vec![0, 0], vec![[1.0, 2.0, 3.0]; 4]));
+        let back = SavedSolution::from_bytes(Path::new("x.rad"), &bytes(&s)).unwrap();
+        assert_eq!(back, s);
+        assert_eq!(back.display().0.patches.len(), 2);
+        // As format 1: no sides, no elements, the rest the same.
+        let old = SavedSolution::from_bytes(Path::new("x.rad"), &as_format_1(&s)).unwrap();
+        assert!(old.elements.is_none());
+        assert!(old.mesh.patches.iter().all(|p| p.side == Side::One));
+        assert_eq!(old.b, s.b);
+        let mut paired = old.mesh.clone();
+        assert_eq!(paired.pair_twins(), 1);
+        assert_eq!(paired.patches, s.mesh.patches);
+        assert_eq!(old.display().0.patches.len(), 2);
     }
 
     #[test]

@@ -42,12 +42,15 @@ pub struct RunSettings {
     pub intersector: IntersectorKind,
     /// Keep per-light channels, grouped so (`--per-light`, `--light-groups`).
     pub per_light: Option<GroupBy>,
+    /// Adaptive elements after the solve (`--elements`, `--element-threshold`, …).
+    pub elements: crate::elements::ElementSettings,
 }
 
 impl RunSettings {
     /// Checks every setting a user can get wrong (one line naming the flag).
     pub fn check(&self) -> Result<(), Invalid> {
         self.mesh.check()?;
+        self.elements.check()?;
         self.solve.check()
     }
 
@@ -58,8 +61,8 @@ impl RunSettings {
 
     /// What a checkpoint must match to be resumed: the scene (its hash) and every setting that
     /// shapes the result, with the patch size as the mesh resolved it. The budgets
-    /// (`--max-time`, `--max-rays`) and the gathering cap are left out: a run may be resumed
-    /// with more time.
+    /// (`--max-time`, `--max-rays`), the gathering cap and the elements (refined after the
+    /// solve, from its result) are left out: a run may be resumed with more time.
     pub fn checkpoint_key(&self, scene_hash: u64, patch_size: f32) -> String {
         let shaping = RunSettings {
             mesh: MeshOptions {
@@ -72,6 +75,7 @@ impl RunSettings {
                 gather_cap_mib: SolveSettings::default().gather_cap_mib,
                 ..self.solve.clone()
             },
+            elements: Default::default(),
             ..self.clone()
         };
         format!(

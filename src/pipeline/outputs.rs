@@ -1,7 +1,10 @@
 //! The files a solve writes into its output folder: `patches.csv` (docs/design.md §5),
-//! `trace.csv`, `render.png`, `summary.json` and, with `--save`, the saved solution.
+//! `elements.csv` (the adaptive elements, [`crate::elements`]; the patches themselves with
+//! `--elements off`), `trace.csv`, `render.png` (drawn from the elements), `summary.json` and,
+//! with `--save`, the saved solution.
 
 use super::SolveJob;
+use crate::elements::{self, Elements};
 use crate::export::solution::{self, SavedMaterial, SolutionMeta};
 use crate::export::{patches, write_atomic};
 use crate::intersect::select::{AnyIntersector, Selection};
@@ -87,6 +90,70 @@ pub fn write(
         patches::write(w, m, &scene.materials, &sol.b, sky_lux)
     })?;
     wrote(csv);
+    // The elements and the gathered picture cast rays: through the solve's intersector, or
+    // one built for them (the methods that cast none).
+    let built;
+    let refine = job.settings.elements.applies_to(m.patches.len());
+    if job.settings.elements.enabled && !refine {
+        log(&format!(
+            "elements: skipped for {} patches (--elements auto refines up to {}; --elements on to refine anyway)",
+            m.patches.len(),
+            elements::AUTO_MAX_PATCHES
+        ));
+    }
+    let needs_rays = refine || job.shading.shading == Shading::Gather;
+    let isect = match run.isect {
+        Some((i, _)) => Some(i),
+        None if needs_rays => {
+            built = model.intersector(job.settings.intersector)?;
+            Some(&built.0)
+        }
+        None => None,
+    };
+    let (elements, element_stats) = match isect {
+        Some(isect) if refine => {
+            run.progress.phase("refining elements");
+            let gather = crate::solve::final_gather::PointGather::new(
+                m,
+                &scene.materials,
+                isect,
+                &sol.b,
+                sky.as_ref(),
+                None,
+            );
+            let (el, st) = elements::refine(
+                m,
+                &gather,
+                &sol.b,
+                &job.settings.elements,
+                job.settings.solve.seed,
+            );
+            log(&format!(
+                "elements: {} from {} patches (threshold {}, min size {:.4} m), {} rays, {:.2} s",
+                st.count, st.patches, st.threshold, st.min_size, st.rays, st.seconds
+            ));
+            if st.capped {
+                log(&format!(
+                    "warning: the elements reached their cap of {} per patch (--element-max); the largest differences were refined first",
+                    job.settings.elements.max_factor
+                ));
+            }
+            (el, Some(st))
+        }
+        _ => (Elements::of_patches(m, &sol.b), None),
+    };
+    let el_csv = job.out.join("elements.csv");
+    write_atomic(&el_csv, |w| {
+        patches::write_elements(
+            w,
+            &elements.mesh,
+            &scene.materials,
+            &elements.b,
+            sky_lux,
+            &elements.patch,
+        )
+    })?;
+    wrote(el_csv);
     let (mut grid_seconds, mut grid_cpu) = (0.0, 0.0);
     let grid = match &job.grid {
         Some(spec) => {
@@ -128,9 +195,14 @@ pub fn write(
     let (lo, hi) = scene.bounds();
     let cam = job.view.camera_for(lo, hi);
     let img = match job.shading.shading {
-        Shading::Gouraud => render_solution(m, &sol.b, &cam, &job.view.image),
+        Shading::Gouraud => {
+            let lin =
+                render::render_linear(&elements.mesh, &elements.vertex_b, &cam, &job.view.image);
+            render::tone_map(&lin, job.view.image.exposure).0
+        }
         Shading::Gather => {
-            let (lin, stats) = gather_picture(job, run, sky.as_ref(), &cam)?;
+            let isect = isect.ok_or_else(|| Error::Invalid("no intersector".into()))?;
+            let (lin, stats) = gather_picture(job, run, isect, sky.as_ref(), &cam)?;
             log(&format!(
                 "render.png: final gather, {:.0} rays per pixel, {:.2} s",
                 stats.rays_per_pixel, stats.seconds
@@ -141,7 +213,7 @@ pub fn write(
     write_png(&png, &img)?;
     wrote(png);
     if let Some(save) = &job.save {
-        save_solution(save, job, model, sol)?;
+        save_solution(save, job, model, sol, &elements)?;
         wrote(save.clone());
     }
 
@@ -171,6 +243,7 @@ pub fn write(
     timings.cpu.total = report::process_cpu_seconds();
     let mut summary = summary(job, run, timings, energy, warnings, outputs);
     summary.grid = grid;
+    summary.elements = element_stats;
     summary.sky = job
         .settings
         .solve
@@ -230,6 +303,7 @@ fn summary(
         hemicube_n: s.method.uses_uniform_cube().then_some(s.hemicube_n),
         switch: sol.stats.switch,
         final_gather: sol.stats.final_gather,
+        elements: None,
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
         cpu_seconds: timings.cpu,
         seconds: timings,
@@ -345,6 +419,7 @@ fn save_solution(
     job: &SolveJob,
     model: &Model,
     sol: &solve::Solution,
+    elements: &Elements,
 ) -> Result<(), Error> {
     let (scene, m) = (&model.scene, &model.mesh);
     let meta = SolutionMeta {
@@ -380,7 +455,16 @@ fn save_solution(
     };
     let vertex_b = m.vertex_values(&sol.b);
     write_atomic(path, |w| {
-        solution::write(w, &meta, m, &sol.b, &sol.unshot, &vertex_b, &sol.channels)
+        solution::write(
+            w,
+            &meta,
+            m,
+            &sol.b,
+            &sol.unshot,
+            &vertex_b,
+            &sol.channels,
+            Some(elements),
+        )
     })?;
     Ok(())
 }
@@ -390,17 +474,10 @@ fn save_solution(
 fn gather_picture(
     job: &SolveJob,
     run: &Run,
+    isect: &AnyIntersector,
     sky: Option<&crate::sky::Sky>,
     cam: &Camera,
 ) -> Result<(render::LinearImage, render::gather::GatherStats), Error> {
-    let built;
-    let isect = match run.isect {
-        Some((i, _)) => i,
-        None => {
-            built = run.model.intersector(job.settings.intersector)?;
-            &built.0
-        }
-    };
     let m = &run.model.mesh;
     let gather = crate::solve::final_gather::PointGather::new(
         m,

@@ -327,6 +327,10 @@ pub struct Summary {
     /// The final gather after the shooting (patches gathered, rays, seconds, black patches
     /// before and after), when one ran; `rays` above are the shooting's.
     pub final_gather: Option<crate::solve::final_gather::GatherStats>,
+    /// The adaptive elements refined after the solve (count, rays, seconds), when they were
+    /// (`--elements auto`, the default, or `on`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elements: Option<crate::elements::ElementStats>,
     /// Rays cast per second of solve time.
     pub rays_per_second: f64,
     pub seconds: Timings,

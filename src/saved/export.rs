@@ -52,12 +52,14 @@ pub(crate) fn export_loaded(
         sol.meta.method,
         sol.meta.seed
     );
+    // The elements when the solution has them (the patches otherwise).
+    let (mesh, vertex_b) = sol.display();
     let mut exposure = 0.0;
     write_atomic(&job.out, |w| {
         exposure = if format == "ply" {
-            ply::write(w, &sol.mesh, &sol.vertex_b, job.exposure, &about)?
+            ply::write(w, mesh, vertex_b, job.exposure, &about)?
         } else {
-            glb::write(w, &sol.mesh, &sol.vertex_b, job.exposure, &about)?
+            glb::write(w, mesh, vertex_b, job.exposure, &about)?
         };
         Ok(())
     })?;
@@ -67,7 +69,7 @@ pub(crate) fn export_loaded(
         out: job.out.display().to_string(),
         format,
         patches: sol.mesh.patches.len(),
-        vertices: sol.mesh.vertices.len(),
+        vertices: mesh.vertices.len(),
         exposure: Some(exposure),
         scale: None,
         shading: None,

@@ -37,6 +37,8 @@ pub fn relight(sol: &SavedSolution, weights: &[(String, f64)]) -> Result<SavedSo
         });
     }
     out.vertex_b = out.mesh.vertex_values(&out.b);
+    // The elements' gathered values are the saved lights': a relit solution shows its patches.
+    out.elements = None;
     Ok(out)
 }
 

@@ -125,7 +125,8 @@ pub(crate) fn render_loaded(
     } else {
         let lin = match job.shading.shading {
             Shading::Gouraud => {
-                render::render_linear(&sol.mesh, &sol.vertex_b, &cam, &job.view.image)
+                let (mesh, vertex_b) = sol.display();
+                render::render_linear(mesh, vertex_b, &cam, &job.view.image)
             }
             Shading::Gather => {
                 let (lin, stats) = gather_image(sol, &cam, job, relit, progress, &mut warnings)?;

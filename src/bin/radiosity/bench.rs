@@ -75,6 +75,42 @@ pub enum BenchCommand {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Adaptive elements (Cohen et al. 1986) against uniform meshing: the error against a
+    /// fine reference at equal element counts, and the count uniform meshing needs for the
+    /// adaptive error (README, "Adaptive elements").
+    Elements {
+        scene: Option<PathBuf>,
+        #[command(flatten)]
+        scene_args: SceneArgs,
+        #[command(flatten)]
+        solve_args: SolverArgs,
+        /// Thresholds of the adaptive meshes (--element-threshold).
+        #[arg(long, value_delimiter = ',', default_value = "0.05,0.1,0.2,0.4")]
+        thresholds: Vec<f64>,
+        /// What the thresholds apply to (--element-test), each measured.
+        #[arg(
+            long,
+            value_enum,
+            value_delimiter = ',',
+            default_value = "midpoints,corners"
+        )]
+        tests: Vec<crate::solve::ElementTestArg>,
+        /// Differences below this fraction of the scene's mean radiosity count as if at it.
+        #[arg(long, default_value_t = radiosity::elements::FLOOR)]
+        floor: f64,
+        /// The smallest element edge, metres (the reference's) [default: the patch size / 8].
+        #[arg(long, value_name = "METRES")]
+        element_min_size: Option<f32>,
+        /// Rays per corner of the uniform and adaptive meshes.
+        #[arg(long, default_value_t = radiosity::elements::DEFAULT_RAYS)]
+        element_rays: usize,
+        /// Rays per corner of the reference.
+        #[arg(long, default_value_t = 1024)]
+        reference_rays: usize,
+        /// Also write the figures as JSON to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// `bench intersect --source`.
@@ -225,7 +261,57 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
             }
             Ok(())
         }
+        BenchCommand::Elements {
+            scene,
+            scene_args,
+            solve_args,
+            thresholds,
+            tests,
+            floor,
+            element_min_size,
+            element_rays,
+            reference_rays,
+            out,
+        } => {
+            let job = radiosity::bench::elements::ElementBenchJob {
+                solve: solve_args.settings(),
+                thresholds,
+                tests: tests.into_iter().map(Into::into).collect(),
+                floor,
+                min_size: element_min_size,
+                rays: element_rays,
+                reference_rays,
+            };
+            bench_elements(scene, scene_args, job, out)
+        }
     }
+}
+
+fn bench_elements(
+    scene: Option<PathBuf>,
+    scene_args: SceneArgs,
+    job: radiosity::bench::elements::ElementBenchJob,
+    out: Option<PathBuf>,
+) -> Result<(), radiosity::Error> {
+    radiosity::elements::ElementSettings {
+        min_size: job.min_size,
+        rays: job.rays.max(job.reference_rays.min(2)),
+        ..Default::default()
+    }
+    .check()?;
+    if job.thresholds.iter().any(|t| !(*t > 0.0 && t.is_finite())) || job.reference_rays < 2 {
+        return Err(radiosity::Error::Invalid(
+            "--thresholds must be positive fractions and --reference-rays at least 2".into(),
+        ));
+    }
+    let model =
+        radiosity::model::Model::load(&source(scene), &scene_args.load(), &scene_args.mesh())?;
+    let r = radiosity::bench::elements::run(&model, &job, &mut |l: &str| eprintln!("{l}"))?;
+    out!("{}", r.markdown());
+    if let Some(path) = out {
+        write_json(&path, &r)?;
+    }
+    Ok(())
 }
 
 fn write_json(path: &std::path::Path, v: &impl serde::Serialize) -> Result<(), radiosity::Error> {

@@ -4,6 +4,7 @@ use crate::args::{source, LightGroupsArg, SceneArgs, ShadingArgs, SolverArgs, Vi
 use crate::sky_args::SkyArgs;
 use crate::{interrupt_flag, outln};
 use clap::Args;
+use radiosity::elements;
 use radiosity::pipeline::{self, RunSettings, SolveJob, DEFAULT_CHECKPOINT_EVERY};
 use radiosity::progress::Progress;
 use radiosity::solve::StopReason;
@@ -19,6 +20,8 @@ pub struct SolveArgs {
     solve_args: SolverArgs,
     #[command(flatten)]
     sky: SkyArgs,
+    #[command(flatten)]
+    elements: ElementArgs,
     /// Output folder.
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -64,6 +67,75 @@ pub struct SolveArgs {
     light_groups: LightGroupsArg,
 }
 
+/// Adaptive elements (Cohen et al. 1986): patches shoot, elements receive.
+#[derive(Args)]
+pub struct ElementArgs {
+    /// After the solve, cut each patch into elements where its light changes (shadow edges,
+    /// corners, beside lights), each corner's radiosity gathered with rays; the picture,
+    /// the exports and elements.csv use them. auto: on for meshes of up to 200,000 patches;
+    /// off: the elements are the patches.
+    #[arg(long, value_enum, default_value_t = ElementsArg::Auto, value_name = "auto|on|off")]
+    elements: ElementsArg,
+    /// Cut an element while the error of its interpolation (the radiosity gathered at the
+    /// points a cut would add, against what its corners interpolate there), relative to its
+    /// mean and times its share of its patch's area, exceeds this (with --element-test
+    /// corners: while its corners differ by more than this fraction of their mean).
+    #[arg(long, value_name = "FRACTION", default_value_t = elements::DEFAULT_THRESHOLD, allow_negative_numbers = true)]
+    element_threshold: f64,
+    /// The smallest element edge, metres [default: the patch size / 8].
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    element_min_size: Option<f32>,
+    /// Rays of each element corner's gather.
+    #[arg(long, value_name = "N", default_value_t = elements::DEFAULT_RAYS)]
+    element_rays: usize,
+    /// At most this many elements per patch in all (the largest differences are cut first).
+    #[arg(long, value_name = "FACTOR", default_value_t = elements::DEFAULT_MAX_FACTOR, allow_negative_numbers = true)]
+    element_max: f64,
+    /// What the threshold applies to: midpoints (the radiosity gathered at the points a cut
+    /// would add against the element's interpolation there: its picture's error) or corners
+    /// (Cohen et al. 1986: the difference between its corners).
+    #[arg(long, value_enum, default_value_t = ElementTestArg::Midpoints)]
+    element_test: ElementTestArg,
+}
+
+/// `--elements`.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum ElementsArg {
+    Auto,
+    On,
+    Off,
+}
+
+/// `--element-test`: see `radiosity::elements::Test`.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum ElementTestArg {
+    Midpoints,
+    Corners,
+}
+
+impl From<ElementTestArg> for elements::Test {
+    fn from(a: ElementTestArg) -> elements::Test {
+        match a {
+            ElementTestArg::Midpoints => elements::Test::Midpoints,
+            ElementTestArg::Corners => elements::Test::Corners,
+        }
+    }
+}
+
+impl ElementArgs {
+    fn settings(&self) -> elements::ElementSettings {
+        elements::ElementSettings {
+            enabled: self.elements != ElementsArg::Off,
+            auto_limit: (self.elements == ElementsArg::Auto).then_some(elements::AUTO_MAX_PATCHES),
+            threshold: self.element_threshold,
+            min_size: self.element_min_size,
+            rays: self.element_rays,
+            max_factor: self.element_max,
+            test: self.element_test.into(),
+        }
+    }
+}
+
 pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
     let solve = radiosity::solve::SolveSettings {
         sky: a.sky.spec().map_err(radiosity::Error::Invalid)?,
@@ -78,6 +150,7 @@ pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
             solve,
             intersector: a.solve_args.intersector(),
             per_light: a.per_light.then_some(a.light_groups.into()),
+            elements: a.elements.settings(),
         },
         view: a.view.settings()?,
         out: a.out.clone(),

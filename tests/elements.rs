@@ -1,0 +1,252 @@
+//! Issue 15, item 1: adaptive elements (Cohen, Greenberg, Immel & Brock 1986, Sec. 3) —
+//! patches shoot, elements receive.
+
+mod common;
+
+use radiosity::elements::{self, ElementSettings, Elements};
+use radiosity::export::solution::SavedSolution;
+use radiosity::intersect::embree::EmbreeScene;
+use radiosity::mesh::Mesh;
+use radiosity::scene::Scene;
+use radiosity::solve::final_gather::PointGather;
+use radiosity::solve::{self, SolveSettings};
+use std::path::Path;
+
+/// Solves `m` and refines its elements with `settings`, on `threads` threads (all when `None`).
+fn refined(
+    s: &Scene,
+    m: &Mesh,
+    settings: &ElementSettings,
+    threads: Option<usize>,
+) -> (Vec<[f64; 3]>, Elements, elements::ElementStats) {
+    let isect = EmbreeScene::build(m, |_| true).unwrap();
+    let sol = solve::solve(m, &s.materials, &isect, &SolveSettings::default(), |_| {}).unwrap();
+    let run = || {
+        let gather = PointGather::new(m, &s.materials, &isect, &sol.b, None, None);
+        elements::refine(m, &gather, &sol.b, settings, 7)
+    };
+    let (el, st) = match threads {
+        None => run(),
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(run),
+    };
+    (sol.b, el, st)
+}
+
+#[test]
+fn elements_tile_each_patch_exactly() {
+    let (s, m) = common::project_scene("spot.obj");
+    let (_, el, st) = refined(&s, &m, &ElementSettings::default(), None);
+    assert!(st.count as usize > m.patches.len(), "{st:?}");
+    let mut area = vec![0.0f64; m.patches.len()];
+    for (e, &p) in el.patch.iter().enumerate() {
+        area[p as usize] += el.mesh.patches[e].area;
+        assert_eq!(el.mesh.patches[e].material, m.patches[p as usize].material);
+        assert_eq!(el.mesh.patches[e].normal, m.patches[p as usize].normal);
+    }
+    for (i, p) in m.patches.iter().enumerate() {
+        assert!(
+            (area[i] - p.area).abs() <= 1e-5 * p.area,
+            "patch {i}: elements {} of {}",
+            area[i],
+            p.area
+        );
+    }
+    // Every value is finite and non-negative; B per element is the mean of its corners.
+    assert!(el
+        .vertex_b
+        .iter()
+        .flatten()
+        .all(|x| x.is_finite() && *x >= 0.0));
+    assert!(el.b.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
+}
+
+/// The furnace: a closed box whose every patch emits and reflects alike is lit uniformly,
+/// B = E/(1 − ρ) everywhere, so no element is cut and each equals the patch B within noise.
+#[test]
+fn a_uniformly_lit_furnace_is_not_subdivided() {
+    let (rho, ke) = (0.5, 1.0);
+    let s = common::closed_box(2.0, 2.0, 2.0, common::material("m", rho, ke));
+    let m = common::mesh_at(&s, Some(0.5));
+    let (_, el, st) = refined(&s, &m, &ElementSettings::default(), None);
+    assert_eq!(st.count as usize, m.patches.len(), "{st:?}");
+    let exact = std::f64::consts::PI * ke / (1.0 - rho);
+    for b in &el.b {
+        for c in b {
+            assert!((c - exact).abs() < 0.03 * exact, "{c} against {exact}");
+        }
+    }
+}
+
+/// The table's shadow on the floor of `spot.obj` (light 0.2 m wide at 3 m, table edge at
+/// 0.8 m and 0.6 m from the centre: the shadow's edge 0.818 m from it, its penumbra 7 cm wide)
+/// is refined to the smallest elements along its edge, and the floor far from any edge is not
+/// (at a threshold of 0.01, as `radiosity bench elements` measures it).
+#[test]
+fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
+    let (s, m) = common::project_scene("spot.obj");
+    let settings = ElementSettings {
+        threshold: 0.01,
+        ..Default::default()
+    };
+    let (_, el, _) = refined(&s, &m, &settings, None);
+    let min = settings.min_size_for(m.patch_size) as f64;
+    let edge = 0.6 * 3.0 / 2.2;
+    let (mut near, mut far) = (0, 0);
+    for (e, p) in el.mesh.patches.iter().enumerate() {
+        let c = p.centre;
+        if p.normal.y < 0.9 || c.y > 0.01 {
+            continue; // the floor only
+        }
+        let (ax, az) = ((c.x as f64 - 2.0).abs(), (c.z as f64 + 2.0).abs());
+        // Along the middle of each side of the shadow's square, within a min size of it.
+        let on_edge = ((ax - edge).abs() < 0.5 * min && az < 0.6)
+            || ((az - edge).abs() < 0.5 * min && ax < 0.6);
+        if on_edge {
+            near += 1;
+            assert!(
+                p.area <= 1.01 * min * min,
+                "element {e} at {c} is {} m²",
+                p.area
+            );
+        }
+        // A smooth stretch of floor between the shadow and the far corner.
+        if c.x > 3.0 && c.x < 3.5 && c.z > -3.5 && c.z < -3.0 {
+            far += 1;
+            assert!(
+                p.area >= 3.99 * min * min,
+                "element {e} at {c} is {} m²",
+                p.area
+            );
+        }
+    }
+    assert!(near > 20 && far > 0, "{near} {far}");
+}
+
+#[test]
+fn elements_do_not_depend_on_the_thread_count() {
+    let (s, m) = common::project_scene("spot.obj");
+    let settings = ElementSettings::default();
+    let (_, one, _) = refined(&s, &m, &settings, Some(1));
+    let (_, two, _) = refined(&s, &m, &settings, Some(2));
+    assert!(one == two, "the elements differ between 1 and 2 threads");
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// `elements.csv` has exactly the columns of `patches.csv` and the element's patch; the saved
+/// solution (format 2) keeps the elements and gives them back to `export` and `render`.
+#[test]
+fn elements_csv_and_the_saved_solution_carry_the_elements() {
+    let dir = tempfile::tempdir().unwrap();
+    let spot = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/spot.obj");
+    let out = dir.path().join("o");
+    let sol_path = dir.path().join("spot.rad");
+    let (code, _, err) = common::run(&[
+        "solve",
+        s(&spot),
+        "--quiet",
+        "--out",
+        s(&out),
+        "--save",
+        s(&sol_path),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
+    let elements = std::fs::read_to_string(out.join("elements.csv")).unwrap();
+    let header = |t: &str| t.lines().next().unwrap().to_string();
+    assert_eq!(header(&elements), format!("{},patch", header(&patches)));
+    let sol = SavedSolution::load(&sol_path).unwrap();
+    let el = sol
+        .elements
+        .as_ref()
+        .expect("the saved solution keeps its elements");
+    assert_eq!(elements.lines().count() - 1, el.mesh.patches.len());
+    assert_eq!(patches.lines().count() - 1, sol.mesh.patches.len());
+    assert!(el.mesh.patches.len() > sol.mesh.patches.len());
+    // The rows' patch ids and values are the saved elements'.
+    for (k, line) in elements.lines().skip(1).enumerate() {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells.last().unwrap().parse::<u32>().unwrap(), el.patch[k]);
+        let b: f64 = cells[14].parse().unwrap();
+        assert!(
+            (b - el.b[k][0]).abs() <= 1e-6 * b.abs().max(1e-6),
+            "{b} {:?}",
+            el.b[k]
+        );
+    }
+    // Save → load → save: the same bytes.
+    let mut again = Vec::new();
+    sol.write(&mut again).unwrap();
+    assert_eq!(again, std::fs::read(&sol_path).unwrap());
+    // The export draws the elements: one PLY vertex per element vertex.
+    let ply = dir.path().join("spot.ply");
+    let (code, _, err) = common::run(&["export", s(&sol_path), "--out", s(&ply)]);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read(&ply).unwrap();
+    let head = String::from_utf8_lossy(&text[..text.len().min(2000)]).to_string();
+    assert!(
+        head.contains(&format!("element vertex {}", el.mesh.vertices.len())),
+        "{head}"
+    );
+    let png = dir.path().join("spot.png");
+    let (code, _, err) = common::run(&["render", s(&sol_path), "--out", s(&png)]);
+    assert_eq!(code, 0, "{err}");
+    // The summary reports them.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(
+        summary["elements"]["count"].as_u64().unwrap() as usize,
+        el.mesh.patches.len()
+    );
+}
+
+/// `--elements auto` (the default) refines meshes up to `AUTO_MAX_PATCHES`; `on`, any.
+#[test]
+fn elements_auto_stops_at_its_patch_limit() {
+    let auto = ElementSettings::default();
+    assert!(auto.applies_to(elements::AUTO_MAX_PATCHES as usize));
+    assert!(!auto.applies_to(elements::AUTO_MAX_PATCHES as usize + 1));
+    let on = ElementSettings {
+        auto_limit: None,
+        ..Default::default()
+    };
+    assert!(on.applies_to(usize::MAX));
+    let off = ElementSettings {
+        enabled: false,
+        ..Default::default()
+    };
+    assert!(!off.applies_to(1));
+}
+
+#[test]
+fn element_flags_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o");
+    for (flag, value, needle) in [
+        ("--element-threshold", "0", "--element-threshold"),
+        ("--element-min-size", "-1", "--element-min-size"),
+        ("--element-rays", "1", "--element-rays"),
+        ("--element-max", "0.5", "--element-max"),
+    ] {
+        common::assert_user_error(
+            &["solve", "--quiet", "--out", s(&out), flag, value],
+            &[needle],
+        );
+    }
+    let (code, help, _) = common::run(&["solve", "--help"]);
+    assert_eq!(code, 0);
+    for flag in [
+        "--elements",
+        "--element-threshold",
+        "--element-min-size",
+        "--element-rays",
+    ] {
+        assert!(help.contains(flag), "{flag} not in solve --help");
+    }
+}
