@@ -936,7 +936,7 @@ impl Gathers {
     /// e_i/√k_i where the gather dominates it. Minimising Σ e_i/√k_i for a given total of rays
     /// Σ n_i k_i (Lagrange) gives n_i k_i ∝ (e_i·√n_i)^(2/3): rays go where the error is, as
     /// the cube root of its square, never fewer than a patch has. The multiplier is found by
-    /// bisection on the model's prediction ([`PatchModel::relative`], which also keeps what
+    /// bisection on the model's prediction (`PatchModel::relative`, which also keeps what
     /// rays cannot remove: the shooting's weight, the light still owed). `None` when even
     /// `max_rays` per patch would not reach `goal`, or there is nothing to gather.
     pub fn plan(&self, np: usize, goal: f64, max_rays: usize) -> Option<RegatherPlan> {
