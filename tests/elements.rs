@@ -25,14 +25,7 @@ fn refined(
         let gather = PointGather::new(m, &s.materials, &isect, &sol.b, None, None);
         elements::refine(m, &gather, &sol.b, settings, 7)
     };
-    let (el, st) = match threads {
-        None => run(),
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .unwrap()
-            .install(run),
-    };
+    let (el, st) = common::on_threads(threads, run);
     (sol.b, el, st)
 }
 

@@ -15,15 +15,9 @@ fn load(file: &str) -> (Scene, Mesh) {
 
 fn solve_in(threads: Option<usize>, s: &Scene, m: &Mesh, cfg: &SolveSettings) -> Solution {
     let isect = EmbreeScene::build(m, |_| true).unwrap();
-    let run = || solve::solve(m, &s.materials, &isect, cfg, |_| {}).unwrap();
-    match threads {
-        None => run(),
-        Some(t) => rayon::ThreadPoolBuilder::new()
-            .num_threads(t)
-            .build()
-            .unwrap()
-            .install(run),
-    }
+    common::on_threads(threads, || {
+        solve::solve(m, &s.materials, &isect, cfg, |_| {}).unwrap()
+    })
 }
 
 /// Bit for bit: the radiosities, and the shots that led to them.

@@ -144,3 +144,16 @@ pub fn project_scene(file: &str) -> (Scene, radiosity::mesh::Mesh) {
     let m = radiosity::mesh::build(&s, &radiosity::mesh::MeshOptions::default());
     (s, m)
 }
+
+/// Runs `f` on a pool of `threads` threads, or on rayon's global pool when `None`: what the
+/// "same result on any thread count" tests compare.
+pub fn on_threads<T: Send>(threads: Option<usize>, f: impl FnOnce() -> T + Send) -> T {
+    match threads {
+        None => f(),
+        Some(t) => rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .unwrap()
+            .install(f),
+    }
+}
