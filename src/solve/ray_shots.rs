@@ -258,19 +258,7 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
     }
 
     /// The hit code of a ray from `org` along `dir` that starts on surface `own` (none for a
-    /// distant emitter's ray).
-    pub(super) fn cast_from<R: Rng>(
-        &self,
-        own: Option<usize>,
-        org: Vec3,
-        dir: Vec3,
-        eps: f32,
-        rng: &mut R,
-    ) -> u32 {
-        self.trace(own, org, dir, eps, rng).0
-    }
-
-    /// [`Self::cast_from`], and the factor per channel the ray's energy carries on with when
+    /// distant emitter's ray), and the factor per channel the ray's energy carries on with when
     /// it went through tinted glazing (the product of the panes' T_c / T; `None` when it met
     /// none).
     pub(super) fn trace<R: Rng>(

@@ -118,7 +118,7 @@ pub(super) fn received_flux<I: Intersector>(
             let hits = (0..grid.len())
                 .filter(|&r| {
                     let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);
-                    caster.cast_from(None, org, dir, 0.0, &mut rng) != ESCAPED
+                    caster.trace(None, org, dir, 0.0, &mut rng).0 != ESCAPED
                 })
                 .count();
             super::scalar(&piece_flux(piece, bounds)) * hits as f64 / grid.len() as f64
