@@ -76,6 +76,17 @@ impl Root {
     }
 }
 
+/// How an element is cut.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Cut {
+    /// Cohen 1986 Sec. 3: at the edge midpoints into four (a quad also at its centre).
+    Four,
+    /// A quad cut in two by the line u = its middle (across its u edges, which run along u).
+    AcrossU,
+    /// A quad cut in two by the line v = its middle.
+    AcrossV,
+}
+
 /// An element: a quad or triangle of one root, by its corners' parameters, in the patch's
 /// winding (counter-clockwise seen from the front).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -114,6 +125,52 @@ impl Elem {
         (0..p.len())
             .map(|k| (p[(k + 1) % p.len()] - p[k]).length())
             .fold(0.0, f64::max)
+    }
+
+    /// Its share of its root's parameter area (4^−depth after cuts in four; halved by a cut
+    /// in two): its share of the root's area in space too, the maps being bilinear and
+    /// affine on planar convex roots up to the quad's non-parallel sides.
+    pub fn share(&self) -> f64 {
+        let u = &self.uv;
+        if self.tri {
+            2.0 * (u[1] - u[0]).perp_dot(u[2] - u[0]).abs()
+        } else {
+            ((u[2].x - u[0].x) * (u[2].y - u[0].y)).abs()
+        }
+    }
+
+    /// A quad's longest edge along u and longest along v, in space (metres).
+    pub fn extents(&self, roots: &[Root]) -> (f64, f64) {
+        let p = self.corners(roots);
+        if p.len() < 4 {
+            let l = self.longest_edge(roots);
+            return (l, l);
+        }
+        let along_u = (p[1] - p[0]).length().max((p[2] - p[3]).length());
+        let along_v = (p[3] - p[0]).length().max((p[2] - p[1]).length());
+        (along_u, along_v)
+    }
+
+    /// The children of `cut` (a triangle is always cut in four).
+    pub fn cut(&self, cut: Cut) -> Vec<Elem> {
+        if self.tri || cut == Cut::Four {
+            return self.split().to_vec();
+        }
+        let u = &self.uv;
+        let mid = |a: DVec2, b: DVec2| (a + b) * 0.5;
+        let child = |uv: [DVec2; 4]| Elem {
+            root: self.root,
+            tri: false,
+            depth: self.depth + 1,
+            uv,
+        };
+        if cut == Cut::AcrossU {
+            let (m01, m23) = (mid(u[0], u[1]), mid(u[3], u[2]));
+            vec![child([u[0], m01, m23, u[3]]), child([m01, u[1], u[2], m23])]
+        } else {
+            let (m12, m30) = (mid(u[1], u[2]), mid(u[0], u[3]));
+            vec![child([u[0], u[1], m12, m30]), child([m30, m12, u[2], u[3]])]
+        }
     }
 
     /// Cohen 1986 Sec. 3: the four children, cut at the edge midpoints (a quad also at its
@@ -214,11 +271,17 @@ mod tests {
             let roots = Root::of_patch(pts);
             let e = roots[0].element(0);
             let whole = area(&e.corners(&roots));
-            let kids: f64 = e.split().iter().map(|c| area(&c.corners(&roots))).sum();
-            assert!((whole - kids).abs() < 1e-12 * whole, "{whole} {kids}");
-            for c in e.split() {
-                let w = c.weights(c.centre_uv()).unwrap();
-                assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+            for cut in [Cut::Four, Cut::AcrossU, Cut::AcrossV] {
+                let kids = e.cut(cut);
+                let sum: f64 = kids.iter().map(|c| area(&c.corners(&roots))).sum();
+                assert!((whole - sum).abs() < 1e-12 * whole, "{whole} {sum}");
+                let shares: f64 = kids.iter().map(Elem::share).sum();
+                assert!((shares - 1.0).abs() < 1e-12, "{cut:?}: {shares}");
+                // Every point of the parent is in a child, which interpolates there.
+                for c in &kids {
+                    let w = c.weights(c.centre_uv()).unwrap();
+                    assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-12);
+                }
             }
         }
     }

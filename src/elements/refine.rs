@@ -19,7 +19,7 @@
 //! the cap ([`super::ElementSettings::max_factor`]) is applied over all the candidates of a
 //! level in a fixed order, so the result does not depend on the thread count.
 
-use super::geometry::{Elem, Root};
+use super::geometry::{Cut, Elem, Root};
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::solve::final_gather::PointGather;
@@ -50,6 +50,13 @@ pub enum Test {
     /// `Corners` in README, "Adaptive elements": the same error with about a third of the
     /// elements.
     Midpoints,
+    /// The midpoint test, and a quad cut in *two* rather than four: across the direction in
+    /// which cutting leaves the smaller interpolation error at the points gathered (a shadow
+    /// edge or a wall's fall-off along one direction is followed by one cut per level, where a
+    /// cut in four spends three elements), the longer side when the two are alike. Two cuts
+    /// in two make the cut in four where the light changes both ways. Triangles are cut in
+    /// four. README, "Adaptive elements", measures it against [`Test::Midpoints`].
+    Halves,
 }
 
 /// How to decide which elements to cut.
@@ -124,76 +131,129 @@ impl<I: Intersector> Refiner<'_, I> {
     /// The largest difference between the radiosity gathered at the corners `e`'s children
     /// would add (its edge midpoints and, for a quad, its centre) and what `e` interpolates
     /// there from its corner values `v` (scalar): the interpolation error the cut would remove.
-    fn deviation(&self, patch: usize, e: &Elem, v: &[f64], w: &mut PatchWork) -> f64 {
+    /// For a quad also the error each cut in two would leave at those points (across u, across
+    /// v: [`Test::Halves`]).
+    fn deviation(
+        &self,
+        patch: usize,
+        e: &Elem,
+        v: &[f64],
+        w: &mut PatchWork,
+    ) -> (f64, Option<(f64, f64)>) {
         let uv = e.corners_uv();
         let n = uv.len();
         let root = w.roots[e.root as usize];
+        // Scalar radiosity gathered at the edge midpoints, edge k running from corner k.
+        let mut m = [0.0; 4];
         let mut worst = 0.0f64;
         for k in 0..n {
             let p = root.at((uv[k] + uv[(k + 1) % n]) * 0.5);
-            let b = scalar(&self.corner(patch, p, w));
-            worst = worst.max((b - 0.5 * (v[k] + v[(k + 1) % n])).abs());
+            m[k] = scalar(&self.corner(patch, p, w));
+            worst = worst.max((m[k] - 0.5 * (v[k] + v[(k + 1) % n])).abs());
         }
-        if !e.tri {
-            let p = root.at(e.centre_uv());
-            let b = scalar(&self.corner(patch, p, w));
-            worst = worst.max((b - v.iter().sum::<f64>() / n as f64).abs());
+        if e.tri {
+            return (worst, None);
         }
-        worst
+        let c = scalar(&self.corner(patch, root.at(e.centre_uv()), w));
+        worst = worst.max((c - v.iter().sum::<f64>() / n as f64).abs());
+        // Edges 0 and 2 run along u, 1 and 3 along v.
+        let along_u = (m[0] - 0.5 * (v[0] + v[1]))
+            .abs()
+            .max((m[2] - 0.5 * (v[2] + v[3])).abs());
+        let along_v = (m[1] - 0.5 * (v[1] + v[2]))
+            .abs()
+            .max((m[3] - 0.5 * (v[3] + v[0])).abs());
+        // Cut across u: the new edge from m₀ to m₂ interpolates the centre; the v edges stay.
+        let left_u = along_v.max((c - 0.5 * (m[0] + m[2])).abs());
+        let left_v = along_u.max((c - 0.5 * (m[1] + m[3])).abs());
+        (worst, Some((left_u, left_v)))
     }
 
     /// One level of patch `patch`: the active elements that `rule` would cut, with their
-    /// contrast (largest first wins under the cap); the others are kept.
-    pub fn level(&self, patch: usize, w: &mut PatchWork, rule: Rule) -> Vec<(f64, usize)> {
+    /// contrast (largest first wins under the cap) and how; the others are kept.
+    pub fn level(&self, patch: usize, w: &mut PatchWork, rule: Rule) -> Vec<(f64, usize, Cut)> {
         let active = std::mem::take(&mut w.active);
         let mut cut = Vec::new();
         let mut keep = Vec::new();
         for e in active {
             let c = match rule {
-                Rule::Uniform(depth) => (e.depth < depth).then_some(f64::INFINITY),
+                Rule::Uniform(depth) => (e.depth < depth).then_some((f64::INFINITY, Cut::Four)),
                 Rule::Adaptive {
                     threshold,
                     floor,
                     min_size,
                     test,
-                } => {
-                    let big = e.longest_edge(&w.roots) >= 2.0 * min_size * (1.0 - 1e-6);
-                    if !big {
-                        None
-                    } else {
-                        let v: Vec<f64> = self.values(patch, &e, w).iter().map(scalar).collect();
-                        let mean = v.iter().sum::<f64>() / v.len() as f64;
-                        let d = match test {
-                            Test::Corners => {
-                                let (lo, hi) =
-                                    v.iter().fold((f64::INFINITY, 0.0f64), |(l, h), &x| {
-                                        (l.min(x), h.max(x))
-                                    });
-                                hi - lo
-                            }
-                            Test::Midpoints => self.deviation(patch, &e, &v, w),
-                        };
-                        let mut contrast = d / mean.max(floor).max(f64::MIN_POSITIVE);
-                        if test == Test::Midpoints {
-                            // Weighed by the element's share of its patch's area, 4^−depth:
-                            // its part in the patch's area-weighted error.
-                            contrast *= 0.25f64.powi(e.depth as i32);
-                        }
-                        (contrast > threshold).then_some(contrast)
-                    }
-                }
+                } => self.decide(patch, &e, w, threshold, floor, min_size, test),
             };
-            match c {
-                Some(c) => {
-                    cut.push((c, w.done.len() + keep.len()));
-                    keep.push(e);
-                }
-                None => keep.push(e),
+            if let Some((c, how)) = c {
+                cut.push((c, w.done.len() + keep.len(), how));
             }
+            keep.push(e);
         }
         // Candidates sit in `done` until the caller says which are cut.
         w.done.extend(keep);
         cut
+    }
+
+    /// Whether `rule`'s threshold cuts `e`, with its contrast and how it is cut.
+    #[allow(clippy::too_many_arguments)]
+    fn decide(
+        &self,
+        patch: usize,
+        e: &Elem,
+        w: &mut PatchWork,
+        threshold: f64,
+        floor: f64,
+        min_size: f64,
+        test: Test,
+    ) -> Option<(f64, Cut)> {
+        let least = 2.0 * min_size * (1.0 - 1e-6);
+        let (along_u, along_v) = e.extents(&w.roots);
+        if along_u.max(along_v) < least {
+            return None;
+        }
+        let v: Vec<f64> = self.values(patch, e, w).iter().map(scalar).collect();
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let (d, how) = match test {
+            Test::Corners => {
+                let (lo, hi) = v
+                    .iter()
+                    .fold((f64::INFINITY, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+                (hi - lo, Cut::Four)
+            }
+            Test::Midpoints => (self.deviation(patch, e, &v, w).0, Cut::Four),
+            Test::Halves => {
+                let (d, left) = self.deviation(patch, e, &v, w);
+                let how = match left {
+                    None => Cut::Four,
+                    Some((left_u, left_v)) => {
+                        // Alike (within 20 %): the longer side, so that elements stay near
+                        // square where the light changes both ways (measured: 0.4–1 here
+                        // change little).
+                        let u = if left_u < 0.8 * left_v {
+                            true
+                        } else if left_v < 0.8 * left_u {
+                            false
+                        } else {
+                            along_u >= along_v
+                        };
+                        if (u && along_u >= least) || along_v < least {
+                            Cut::AcrossU
+                        } else {
+                            Cut::AcrossV
+                        }
+                    }
+                };
+                (d, how)
+            }
+        };
+        let mut contrast = d / mean.max(floor).max(f64::MIN_POSITIVE);
+        if test != Test::Corners {
+            // Weighed by the element's share of its root's area (4^−depth after cuts in four):
+            // its part in the patch's area-weighted error.
+            contrast *= e.share();
+        }
+        (contrast > threshold).then_some((contrast, how))
     }
 }
 
@@ -234,35 +294,51 @@ pub(super) fn run<I: Intersector>(
         if work.iter().all(|w| w.active.is_empty()) {
             break;
         }
-        let cands: Vec<Vec<(f64, usize)>> = work
+        let cands: Vec<Vec<(f64, usize, Cut)>> = work
             .par_iter_mut()
             .enumerate()
             .map(|(i, w)| r.level(i, w, rule))
             .collect();
-        let mut all: Vec<(f64, usize, usize)> = cands
+        let mut all: Vec<(f64, usize, usize, Cut)> = cands
             .iter()
             .enumerate()
-            .flat_map(|(p, c)| c.iter().map(move |&(x, at)| (x, p, at)))
+            .flat_map(|(p, c)| c.iter().map(move |&(x, at, how)| (x, p, at, how)))
             .collect();
-        // Each cut adds three elements.
-        let room = cap.saturating_sub(total) / 3;
-        if all.len() > room {
+        // A cut in four adds three elements, a cut in two one.
+        let added = |how: Cut, w: &PatchWork, at: usize| {
+            if how == Cut::Four || w.done[at].tri {
+                3
+            } else {
+                1
+            }
+        };
+        let room = cap.saturating_sub(total);
+        let wanted: usize = all.iter().map(|c| added(c.3, &work[c.1], c.2)).sum();
+        if wanted > room {
             capped = true;
             all.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-            all.truncate(room);
+            let mut used = 0;
+            all.retain(|c| {
+                let n = added(c.3, &work[c.1], c.2);
+                let fits = used + n <= room;
+                if fits {
+                    used += n;
+                }
+                fits
+            });
         }
-        let mut chosen: Vec<Vec<usize>> = vec![Vec::new(); work.len()];
-        for &(_, p, at) in &all {
-            chosen[p].push(at);
+        let mut chosen: Vec<Vec<(usize, Cut)>> = vec![Vec::new(); work.len()];
+        for &(_, p, at, how) in &all {
+            total += added(how, &work[p], at);
+            chosen[p].push((at, how));
         }
-        total += 3 * all.len();
         for (w, mut picks) in work.iter_mut().zip(chosen) {
             // Remove the cut ones from `done` (largest index first) and make their children
             // the next level.
-            picks.sort_unstable_by(|a, b| b.cmp(a));
-            for at in picks {
+            picks.sort_unstable_by(|a, b| b.0.cmp(&a.0));
+            for (at, how) in picks {
                 let e = w.done.swap_remove(at);
-                w.active.extend(e.split());
+                w.active.extend(e.cut(how));
             }
         }
         if capped {

@@ -111,6 +111,7 @@ pub enum ElementsArg {
 pub enum ElementTestArg {
     Midpoints,
     Corners,
+    Halves,
 }
 
 impl From<ElementTestArg> for elements::Test {
@@ -118,6 +119,7 @@ impl From<ElementTestArg> for elements::Test {
         match a {
             ElementTestArg::Midpoints => elements::Test::Midpoints,
             ElementTestArg::Corners => elements::Test::Corners,
+            ElementTestArg::Halves => elements::Test::Halves,
         }
     }
 }
