@@ -133,7 +133,7 @@ impl Elem {
     pub fn share(&self) -> f64 {
         let u = &self.uv;
         if self.tri {
-            2.0 * (u[1] - u[0]).perp_dot(u[2] - u[0]).abs()
+            (u[1] - u[0]).perp_dot(u[2] - u[0]).abs()
         } else {
             ((u[2].x - u[0].x) * (u[2].y - u[0].y)).abs()
         }
