@@ -76,8 +76,9 @@ fn a_uniformly_lit_furnace_is_not_subdivided() {
 
 /// The table's shadow on the floor of `spot.obj` (light 0.2 m wide at 3 m, table edge at
 /// 0.8 m and 0.6 m from the centre: the shadow's edge 0.818 m from it, its penumbra 7 cm wide)
-/// is refined to the smallest elements along its edge, and the floor far from any edge is not
-/// (at a threshold of 0.01, as `radiosity bench elements` measures it).
+/// is refined to the smallest elements across its edge (cut in two, the default
+/// [`elements::Test::Halves`], they may stay longer along it), and the floor far from any edge
+/// is not (at a threshold of 0.01, as `radiosity bench elements` measures it).
 #[test]
 fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
     let (s, m) = common::project_scene("spot.obj");
@@ -88,7 +89,7 @@ fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
     let (_, el, _) = refined(&s, &m, &settings, None);
     let min = settings.min_size_for(m.patch_size) as f64;
     let edge = 0.6 * 3.0 / 2.2;
-    let (mut near, mut far) = (0, 0);
+    let (mut along, mut far) = (0.0, 0);
     for (e, p) in el.mesh.patches.iter().enumerate() {
         let c = p.centre;
         if p.normal.y < 0.9 || c.y > 0.01 {
@@ -96,15 +97,22 @@ fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
         }
         let (ax, az) = ((c.x as f64 - 2.0).abs(), (c.z as f64 + 2.0).abs());
         // Along the middle of each side of the shadow's square, within a min size of it.
-        let on_edge = ((ax - edge).abs() < 0.5 * min && az < 0.6)
-            || ((az - edge).abs() < 0.5 * min && ax < 0.6);
-        if on_edge {
-            near += 1;
-            assert!(
-                p.area <= 1.01 * min * min,
-                "element {e} at {c} is {} m²",
-                p.area
+        let across_x = (ax - edge).abs() < 0.5 * min && az < 0.6;
+        let across_z = (az - edge).abs() < 0.5 * min && ax < 0.6;
+        if across_x || across_z {
+            let (lo, hi) = el.mesh.patch_indices(e).iter().fold(
+                (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+                |(l, h), &v| {
+                    let q = el.mesh.vertices[v as usize];
+                    (l.min(q), h.max(q))
+                },
             );
+            let width = if across_x { hi.x - lo.x } else { hi.z - lo.z } as f64;
+            assert!(
+                width <= 1.01 * min,
+                "element {e} at {c} is {width} m across the edge"
+            );
+            along += if across_x { hi.z - lo.z } else { hi.x - lo.x } as f64;
         }
         // A smooth stretch of floor between the shadow and the far corner.
         if c.x > 3.0 && c.x < 3.5 && c.z > -3.5 && c.z < -3.0 {
@@ -116,7 +124,26 @@ fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
             );
         }
     }
-    assert!(near > 20 && far > 0, "{near} {far}");
+    // The four sides' middle 1.2 m each are lined with such elements.
+    assert!(along > 0.9 * 4.0 * 1.2 && far > 0, "{along} {far}");
+}
+
+/// Ctrl-C before the refinement: each patch is kept whole (the spot's patches are quads),
+/// with its corners gathered, and the stats say so.
+#[test]
+fn ctrl_c_keeps_what_is_refined() {
+    let (s, m) = common::project_scene("spot.obj");
+    let isect = EmbreeScene::build(&m, |_| true).unwrap();
+    let sol = solve::solve(&m, &s.materials, &isect, &SolveSettings::default(), |_| {}).unwrap();
+    let gather = PointGather::new(&m, &s.materials, &isect, &sol.b, None, None);
+    let stop = std::sync::atomic::AtomicBool::new(true);
+    let settings = ElementSettings::default();
+    let (el, st) = elements::refine_until(&m, &gather, &sol.b, &settings, 7, Some(&stop));
+    assert!(st.interrupted, "{st:?}");
+    assert_eq!(st.count as usize, m.patches.len());
+    assert!(el.b.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
+    let (_, full) = elements::refine(&m, &gather, &sol.b, &settings, 7);
+    assert!(!full.interrupted && full.count > st.count, "{full:?}");
 }
 
 #[test]

@@ -93,6 +93,8 @@ pub(super) struct Refiner<'a, I> {
     pub seed: u64,
     pub rays: usize,
     pub quantum: f64,
+    /// Set on Ctrl-C: refine no further (what is refined is kept).
+    pub stop: Option<&'a std::sync::atomic::AtomicBool>,
 }
 
 /// The cache key of a position.
@@ -102,6 +104,12 @@ pub(super) fn key(p: DVec3, quantum: f64) -> [i64; 3] {
 }
 
 impl<I: Intersector> Refiner<'_, I> {
+    /// Whether Ctrl-C asked to stop.
+    pub fn stopped(&self) -> bool {
+        self.stop
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+    }
+
     /// The radiosity at corner `p` of patch `patch`, gathered once (Cohen 1986 Sec. 3, with a
     /// gather for the hemi-cube).
     fn corner(&self, patch: usize, p: DVec3, w: &mut PatchWork) -> [f64; 3] {
@@ -175,6 +183,10 @@ impl<I: Intersector> Refiner<'_, I> {
         let active = std::mem::take(&mut w.active);
         let mut cut = Vec::new();
         let mut keep = Vec::new();
+        if self.stopped() {
+            w.done.extend(active);
+            return cut;
+        }
         for e in active {
             let c = match rule {
                 Rule::Uniform(depth) => (e.depth < depth).then_some((f64::INFINITY, Cut::Four)),
@@ -259,7 +271,8 @@ impl<I: Intersector> Refiner<'_, I> {
 
 /// Runs the refinement of every patch to its fixed point under `rule`, with at most `cap`
 /// elements in all (the candidates with the largest contrast are cut first; patch order
-/// breaks ties). Returns each patch's work and whether the cap stopped it.
+/// breaks ties). Returns each patch's work and whether the cap stopped it. Ctrl-C
+/// ([`Refiner::stop`]) ends it at the next patch, keeping what is refined.
 pub(super) fn run<I: Intersector>(
     r: &Refiner<'_, I>,
     rule: Rule,
@@ -312,6 +325,13 @@ pub(super) fn run<I: Intersector>(
                 1
             }
         };
+        if r.stopped() {
+            for w in &mut work {
+                let a = std::mem::take(&mut w.active);
+                w.done.extend(a);
+            }
+            break;
+        }
         let room = cap.saturating_sub(total);
         let wanted: usize = all.iter().map(|c| added(c.3, &work[c.1], c.2)).sum();
         if wanted > room {
@@ -335,7 +355,7 @@ pub(super) fn run<I: Intersector>(
         for (w, mut picks) in work.iter_mut().zip(chosen) {
             // Remove the cut ones from `done` (largest index first) and make their children
             // the next level.
-            picks.sort_unstable_by(|a, b| b.0.cmp(&a.0));
+            picks.sort_unstable_by_key(|p| std::cmp::Reverse(p.0));
             for (at, how) in picks {
                 let e = w.done.swap_remove(at);
                 w.active.extend(e.cut(how));

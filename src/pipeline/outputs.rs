@@ -110,8 +110,13 @@ pub fn write(
         }
         None => None,
     };
+    // A solve Ctrl-C stopped writes what it has at once: its patches, not elements.
+    let interrupted = job
+        .interrupt
+        .as_ref()
+        .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
     let (elements, element_stats) = match isect {
-        Some(isect) if refine => {
+        Some(isect) if refine && !interrupted => {
             run.progress.phase("refining elements");
             let gather = crate::solve::final_gather::PointGather::new(
                 m,
@@ -121,17 +126,21 @@ pub fn write(
                 sky.as_ref(),
                 None,
             );
-            let (el, st) = elements::refine(
+            let (el, st) = elements::refine_until(
                 m,
                 &gather,
                 &sol.b,
                 &job.settings.elements,
                 job.settings.solve.seed,
+                job.interrupt.as_deref(),
             );
             log(&format!(
                 "elements: {} from {} patches (threshold {}, min size {:.4} m), {} rays, {:.2} s",
                 st.count, st.patches, st.threshold, st.min_size, st.rays, st.seconds
             ));
+            if st.interrupted {
+                log("interrupted: the elements refined so far are kept");
+            }
             if st.capped {
                 log(&format!(
                     "warning: the elements reached their cap of {} per patch (--element-max); the largest differences were refined first",

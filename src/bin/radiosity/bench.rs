@@ -85,14 +85,18 @@ pub enum BenchCommand {
         #[command(flatten)]
         solve_args: SolverArgs,
         /// Thresholds of the adaptive meshes (--element-threshold).
-        #[arg(long, value_delimiter = ',', default_value = "0.05,0.1,0.2,0.4")]
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "0.005,0.01,0.02,0.04,0.08"
+        )]
         thresholds: Vec<f64>,
         /// What the thresholds apply to (--element-test), each measured.
         #[arg(
             long,
             value_enum,
             value_delimiter = ',',
-            default_value = "midpoints,corners"
+            default_value = "halves,midpoints"
         )]
         tests: Vec<crate::solve::ElementTestArg>,
         /// Differences below this fraction of the scene's mean radiosity count as if at it.
@@ -105,7 +109,7 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = radiosity::elements::DEFAULT_RAYS)]
         element_rays: usize,
         /// Rays per corner of the reference.
-        #[arg(long, default_value_t = 1024)]
+        #[arg(long, default_value_t = 2048)]
         reference_rays: usize,
         /// Also write the figures as JSON to this file.
         #[arg(long)]

@@ -72,7 +72,7 @@ pub struct SolveArgs {
 pub struct ElementArgs {
     /// After the solve, cut each patch into elements where its light changes (shadow edges,
     /// corners, beside lights), each corner's radiosity gathered with rays; the picture,
-    /// the exports and elements.csv use them. auto: on for meshes of up to 50,000 patches;
+    /// the exports and elements.csv use them. auto: on for meshes of up to 25,000 patches;
     /// off: the elements are the patches.
     #[arg(long, value_enum, default_value_t = ElementsArg::Auto, value_name = "auto|on|off")]
     elements: ElementsArg,
@@ -91,10 +91,12 @@ pub struct ElementArgs {
     /// At most this many elements per patch in all (the largest differences are cut first).
     #[arg(long, value_name = "FACTOR", default_value_t = elements::DEFAULT_MAX_FACTOR, allow_negative_numbers = true)]
     element_max: f64,
-    /// What the threshold applies to: midpoints (the radiosity gathered at the points a cut
-    /// would add against the element's interpolation there: its picture's error) or corners
-    /// (Cohen et al. 1986: the difference between its corners).
-    #[arg(long, value_enum, default_value_t = ElementTestArg::Midpoints)]
+    /// What the threshold applies to, and how an element is cut: halves (the radiosity
+    /// gathered at the points a cut would add against the element's interpolation there, its
+    /// picture's error; a quad cut in two across the direction the light changes along),
+    /// midpoints (the same test, cut in four) or corners (Cohen et al. 1986: the difference
+    /// between its corners, cut in four).
+    #[arg(long, value_enum, default_value_t = ElementTestArg::Halves)]
     element_test: ElementTestArg,
 }
 
