@@ -171,6 +171,7 @@ pub fn run(
         job.reference_rays,
         usize::MAX,
         seed,
+        None,
     );
     log(&format!(
         "reference: {} elements, {} rays, {:.1} s",
@@ -180,8 +181,15 @@ pub fn run(
     let unlit = UNLIT * elements::mean_radiosity(m, &sol.b);
     let mut rows = Vec::new();
     for d in 0..=depth {
-        let (el, st) =
-            elements::refine_by(m, &gather, Rule::Uniform(d), job.rays, usize::MAX, seed);
+        let (el, st) = elements::refine_by(
+            m,
+            &gather,
+            Rule::Uniform(d),
+            job.rays,
+            usize::MAX,
+            seed,
+            None,
+        );
         let (error, energy_error) = error_against(model, &reference, &el, unlit);
         log(&format!(
             "uniform depth {d}: {} elements, error {:.2} % (energy {:.2} %), {:.2} s",
@@ -212,7 +220,7 @@ pub fn run(
             min_size,
             test,
         };
-        let (el, st) = elements::refine_by(m, &gather, rule, job.rays, usize::MAX, seed);
+        let (el, st) = elements::refine_by(m, &gather, rule, job.rays, usize::MAX, seed, None);
         let (error, energy_error) = error_against(model, &reference, &el, unlit);
         log(&format!(
             "adaptive {test:?} threshold {threshold}: {} elements, error {:.2} % (energy {:.2} %), {:.2} s",

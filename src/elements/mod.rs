@@ -307,26 +307,15 @@ pub fn refine_until<I: Intersector>(
         test: settings.test,
     };
     let cap = (settings.max_factor * mesh.patches.len() as f64).ceil() as usize;
-    let (el, mut stats) = refine_by_until(mesh, gather, rule, settings.rays, cap, seed, stop);
+    let (el, mut stats) = refine_by(mesh, gather, rule, settings.rays, cap, seed, stop);
     stats.threshold = settings.threshold;
     stats.min_size = min_size;
     (el, stats)
 }
 
 /// [`refine()`] by any [`Rule`] (the uniform meshing it is measured against), with `rays` per
-/// corner and at most `cap` elements.
+/// corner and at most `cap` elements, stopping early once `stop` is set.
 pub fn refine_by<I: Intersector>(
-    mesh: &Mesh,
-    gather: &PointGather<'_, I>,
-    rule: Rule,
-    rays: usize,
-    cap: usize,
-    seed: u64,
-) -> (Elements, ElementStats) {
-    refine_by_until(mesh, gather, rule, rays, cap, seed, None)
-}
-
-fn refine_by_until<I: Intersector>(
     mesh: &Mesh,
     gather: &PointGather<'_, I>,
     rule: Rule,
