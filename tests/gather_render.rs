@@ -30,6 +30,7 @@ fn gather_settings(rays: usize, seed: u64) -> ShadingSettings {
         shading: Shading::Gather,
         rays,
         seed,
+        ..Default::default()
     }
 }
 
@@ -94,13 +95,7 @@ fn a_furnace_renders_flat_at_its_analytic_radiosity() {
 #[test]
 fn the_picture_depends_on_the_seed_only() {
     let (scene, m, b) = shadow_room();
-    let cam = Camera::perspective(
-        vec3(0.3, 2.5, 0.3),
-        vec3(2.5, 0.0, 2.5),
-        Vec3::Y,
-        70.0,
-        40.0 / 30.0,
-    );
+    let cam = room_camera(40.0 / 30.0);
     let o = opts(40, 30, 2);
     let on = |threads: usize, seed: u64| {
         rayon::ThreadPoolBuilder::new()
@@ -112,6 +107,57 @@ fn the_picture_depends_on_the_seed_only() {
     let one = on(1, 7);
     assert_eq!(one, on(3, 7), "the thread count changed the picture");
     assert_ne!(one, on(3, 8), "another seed gave the same picture");
+}
+
+/// The indirect light gathered at nodes every 4 pixels and interpolated (the default) against
+/// gathered at every sample (`--indirect-spacing 0`), both with 16 rays per sample, and a
+/// reference of 512 rays per sample: the two agree on the mean (the direct and indirect
+/// parts add up to the whole, nothing counted twice or lost) and the nodes' picture is
+/// nearer the reference per pixel (its indirect light gathered with more rays).
+#[test]
+fn indirect_nodes_keep_the_mean_and_lower_the_noise() {
+    let (scene, m, b) = shadow_room();
+    let cam = room_camera(64.0 / 48.0);
+    let o = opts(64, 48, 2);
+    let at = |rays: usize, spacing: usize| {
+        let s = ShadingSettings {
+            indirect_spacing: spacing,
+            ..gather_settings(rays, 5)
+        };
+        gathered(&scene, &m, &b, &cam, &o, &s)
+    };
+    let reference = at(512, 0);
+    let stats = |img: &LinearImage| {
+        let (mut err, mut n, mut sum, mut sum_ref) = (0.0, 0.0, 0.0, 0.0);
+        for (p, r) in img.pixels.iter().zip(&reference.pixels) {
+            let (l, lr) = (luminance(p), luminance(r));
+            sum += l;
+            sum_ref += lr;
+            if lr > 0.0 {
+                err += (l - lr).abs() / lr;
+                n += 1.0;
+            }
+        }
+        (sum / sum_ref - 1.0, err / n)
+    };
+    let (bias_nodes, err_nodes) = stats(&at(16, 4));
+    let (bias_each, err_each) = stats(&at(16, 0));
+    eprintln!(
+        "nodes: mean {bias_nodes:+.4}, error {err_nodes:.4}; each sample: mean {bias_each:+.4}, error {err_each:.4}"
+    );
+    assert!(bias_nodes.abs() < 0.01 && bias_each.abs() < 0.01);
+    assert!(err_nodes < err_each, "{err_nodes} against {err_each}");
+}
+
+/// A view of [`shadow_room`] from high in one corner, of aspect `aspect`.
+fn room_camera(aspect: f32) -> Camera {
+    Camera::perspective(
+        vec3(0.3, 2.5, 0.3),
+        vec3(2.5, 0.0, 2.5),
+        Vec3::Y,
+        70.0,
+        aspect,
+    )
 }
 
 /// A 4 × 3 × 4 m room (ρ 0.5, 1 m patches) lit by a 0.2 m lamp in the middle of the ceiling,
@@ -354,6 +400,17 @@ fn the_commands_take_the_shading_flags() {
             "0",
         ],
         &["--pixel-rays", "between 1 and"],
+    );
+    assert_user_error(
+        &[
+            "render",
+            s(&sol),
+            "--out",
+            s(&d.join("x.png")),
+            "--indirect-spacing",
+            "65",
+        ],
+        &["--indirect-spacing", "between 0 and 64"],
     );
 }
 

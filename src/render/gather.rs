@@ -35,9 +35,10 @@
 
 use super::{Camera, LinearImage, RenderOptions};
 use crate::intersect::Intersector;
+use crate::mesh::Mesh;
 use crate::progress::Counter;
 use crate::settings::Invalid;
-use crate::solve::final_gather::PointGather;
+use crate::solve::final_gather::{LightParts, PointGather};
 use crate::solve::rng_for;
 use glam::Vec3;
 use rand::Rng;
@@ -51,6 +52,16 @@ pub const RENDER_STREAM: u64 = u64::MAX - 4;
 /// Rays gathered per anti-aliasing sample by default (`--pixel-rays`): with the default 3×3
 /// samples, 144 per pixel (README, "Final-gather pictures", for the measurements behind it).
 pub const DEFAULT_PIXEL_RAYS: usize = 16;
+
+/// Default `--indirect-spacing`: pixels between the points where the indirect light is
+/// gathered and interpolated from (0: at every sample).
+pub const DEFAULT_INDIRECT_SPACING: usize = 4;
+
+/// Most `--indirect-spacing`.
+pub const MAX_INDIRECT_SPACING: usize = 64;
+
+/// A node gathers this many times the hemisphere rays of one pixel's samples.
+pub const NODE_GAIN: usize = 4;
 
 /// Most rays per sample `--pixel-rays` takes.
 pub const MAX_PIXEL_RAYS: usize = 65_536;
@@ -88,6 +99,9 @@ pub struct ShadingSettings {
     pub rays: usize,
     /// Seed of the pixels' random numbers.
     pub seed: u64,
+    /// Pixels between the nodes where the indirect light is gathered, to be interpolated
+    /// between them over one surface (`--indirect-spacing`; 0: gathered at every sample).
+    pub indirect_spacing: usize,
 }
 
 impl Default for ShadingSettings {
@@ -96,6 +110,7 @@ impl Default for ShadingSettings {
             shading: Shading::default(),
             rays: DEFAULT_PIXEL_RAYS,
             seed: 1,
+            indirect_spacing: DEFAULT_INDIRECT_SPACING,
         }
     }
 }
@@ -107,6 +122,12 @@ impl ShadingSettings {
             return Invalid::err(format!(
                 "--pixel-rays must be between 1 and {MAX_PIXEL_RAYS}, got {}",
                 self.rays
+            ));
+        }
+        if self.indirect_spacing > MAX_INDIRECT_SPACING {
+            return Invalid::err(format!(
+                "--indirect-spacing must be between 0 and {MAX_INDIRECT_SPACING} pixels, got {}",
+                self.indirect_spacing
             ));
         }
         Ok(())
@@ -148,6 +169,117 @@ struct Group {
     patch: usize,
     points: Vec<Vec3>,
     weight: [f64; 3],
+    /// The points whose indirect light no nodes interpolate, and their weight.
+    alone: Vec<Vec3>,
+    alone_weight: [f64; 3],
+}
+
+/// The indirect light gathered at one node of the image: ρ·H_indirect of the side seen
+/// there, and which surface (polygon and facing) that side is.
+#[derive(Clone, Copy)]
+struct Node {
+    polygon: u32,
+    normal: Vec3,
+    value: [f64; 3],
+}
+
+/// The nodes: the indirect light at every `spacing`-th pixel corner, in rows of `cols`.
+struct Nodes {
+    spacing: f32,
+    cols: usize,
+    rows: usize,
+    at: Vec<Option<Node>>,
+}
+
+impl Nodes {
+    /// Gathers the nodes of a `width`×`height` picture, `rays` hemisphere rays each; returns
+    /// them and the rays cast.
+    fn gather<I: Intersector>(
+        gather: &PointGather<I>,
+        camera: &Camera,
+        (width, height): (usize, usize),
+        spacing: usize,
+        rays: usize,
+        seed: u64,
+    ) -> (Nodes, u64) {
+        let cols = width.div_ceil(spacing) + 1;
+        let rows = height.div_ceil(spacing) + 1;
+        let (fw, fh) = (width as f32, height as f32);
+        let mesh = gather.mesh();
+        let per_row: Vec<(Vec<Option<Node>>, u64)> = (0..rows)
+            .into_par_iter()
+            .map(|j| {
+                let mut cast = 0;
+                let row = (0..cols)
+                    .map(|i| {
+                        let index = (j * cols + i) as u64;
+                        // A stream of its own: pixel indices stay far below 2^63.
+                        let mut rng = rng_for(seed, RENDER_STREAM, (1 << 63) | index);
+                        let (x, y) = ((i * spacing) as f32, (j * spacing) as f32);
+                        let (org, dir) = primary_ray(camera, x, y, fw, fh)?;
+                        let seen = gather.view(org, dir);
+                        cast += seen.rays;
+                        let h = seen.hit?;
+                        let (value, n) = gather.part_at(
+                            h.patch,
+                            &[h.point],
+                            rays,
+                            LightParts::Indirect,
+                            &mut rng,
+                        );
+                        cast += n;
+                        let p = &mesh.patches[h.patch];
+                        Some(Node {
+                            polygon: p.polygon,
+                            normal: p.normal,
+                            value,
+                        })
+                    })
+                    .collect();
+                (row, cast)
+            })
+            .collect();
+        let cast = per_row.iter().map(|r| r.1).sum();
+        let at = per_row.into_iter().flat_map(|r| r.0).collect();
+        (
+            Nodes {
+                spacing: spacing as f32,
+                cols,
+                rows,
+                at,
+            },
+            cast,
+        )
+    }
+
+    /// The indirect light at image point (x, y) on `patch`, interpolated bilinearly from the
+    /// four nodes around it when all four saw the same surface (its polygon, facing alike);
+    /// `None` otherwise (an edge, a corner, another object between): gathered there instead.
+    fn interpolate(&self, mesh: &Mesh, patch: usize, x: f32, y: f32) -> Option<[f64; 3]> {
+        let (gx, gy) = (x / self.spacing, y / self.spacing);
+        let (i, j) = (gx.floor() as usize, gy.floor() as usize);
+        if i + 1 >= self.cols || j + 1 >= self.rows {
+            return None;
+        }
+        let (tx, ty) = (f64::from(gx - i as f32), f64::from(gy - j as f32));
+        let p = &mesh.patches[patch];
+        let mut v = [0.0; 3];
+        for (di, dj, w) in [
+            (0, 0, (1.0 - tx) * (1.0 - ty)),
+            (1, 0, tx * (1.0 - ty)),
+            (0, 1, (1.0 - tx) * ty),
+            (1, 1, tx * ty),
+        ] {
+            let n = self.at[(j + dj) * self.cols + i + di]?;
+            if n.polygon != p.polygon || n.normal.dot(p.normal) < 0.999 {
+                return None;
+            }
+            for (x, y) in v.iter_mut().zip(n.value) {
+                *x += w * y;
+            }
+        }
+        Some(v)
+    }
 }
 
 /// Renders the view of `camera` by a final gather per pixel through `gather` (see the module
@@ -178,6 +310,21 @@ pub fn render_gather<I: Intersector>(
     let s = opts.supersample.clamp(1, 16) as usize;
     let (fw, fh) = (opts.width as f32, opts.height as f32);
     let rays = settings.rays.clamp(1, MAX_PIXEL_RAYS);
+    // With nodes, half a sample's rays go to the lights at the sample and the hemisphere's
+    // half is gathered at the nodes, NODE_GAIN pixels' worth each.
+    let spacing = settings.indirect_spacing.min(MAX_INDIRECT_SPACING);
+    let half = (rays / 2).max(1);
+    let nodes = (spacing > 0).then(|| {
+        Nodes::gather(
+            gather,
+            camera,
+            (width, height),
+            spacing,
+            half * s * s * NODE_GAIN,
+            settings.seed,
+        )
+    });
+    let mesh = gather.mesh();
     let counts: Vec<u64> = pixels
         .par_chunks_mut(width)
         .enumerate()
@@ -201,29 +348,75 @@ pub fn render_gather<I: Intersector>(
                     cast += seen.rays;
                     add(&mut sum, seen.panes, [1.0; 3]);
                     match seen.hit {
-                        Some(h) => match groups.iter_mut().find(|g| g.patch == h.patch) {
-                            Some(g) => {
-                                g.points.push(h.point);
-                                for q in 0..3 {
-                                    g.weight[q] += seen.through[q];
+                        Some(h) => {
+                            let at = match groups.iter().position(|g| g.patch == h.patch) {
+                                Some(at) => at,
+                                None => {
+                                    groups.push(Group {
+                                        patch: h.patch,
+                                        points: Vec::new(),
+                                        weight: [0.0; 3],
+                                        alone: Vec::new(),
+                                        alone_weight: [0.0; 3],
+                                    });
+                                    groups.len() - 1
+                                }
+                            };
+                            let g = &mut groups[at];
+                            g.points.push(h.point);
+                            for q in 0..3 {
+                                g.weight[q] += seen.through[q];
+                            }
+                            let ind = nodes
+                                .as_ref()
+                                .and_then(|(n, _)| n.interpolate(mesh, h.patch, fx, fy));
+                            match ind {
+                                Some(v) => add(&mut sum, v, seen.through),
+                                None => {
+                                    g.alone.push(h.point);
+                                    for q in 0..3 {
+                                        g.alone_weight[q] += seen.through[q];
+                                    }
                                 }
                             }
-                            None => groups.push(Group {
-                                patch: h.patch,
-                                points: vec![h.point],
-                                weight: seen.through,
-                            }),
-                        },
+                        }
                         None => {
                             add(&mut sum, gather.sky_exitance(dir), seen.through);
                         }
                     }
                 }
                 for g in &groups {
-                    let (b, n) =
-                        gather.radiosity_at(g.patch, &g.points, rays * g.points.len(), &mut rng);
+                    if nodes.is_none() {
+                        let (b, n) = gather.radiosity_at(
+                            g.patch,
+                            &g.points,
+                            rays * g.points.len(),
+                            &mut rng,
+                        );
+                        cast += n;
+                        add(&mut sum, b, g.weight);
+                        continue;
+                    }
+                    let (b, n) = gather.part_at(
+                        g.patch,
+                        &g.points,
+                        half * g.points.len(),
+                        LightParts::Direct,
+                        &mut rng,
+                    );
                     cast += n;
                     add(&mut sum, b, g.weight);
+                    if !g.alone.is_empty() {
+                        let (b, n) = gather.part_at(
+                            g.patch,
+                            &g.alone,
+                            half * g.alone.len(),
+                            LightParts::Indirect,
+                            &mut rng,
+                        );
+                        cast += n;
+                        add(&mut sum, b, g.alone_weight);
+                    }
                 }
                 *px = sum.map(|v| {
                     let v = (v / (s * s) as f64) as f32;
@@ -239,7 +432,7 @@ pub fn render_gather<I: Intersector>(
         })
         .collect();
     stats.samples = (width * height * s * s) as u64;
-    stats.rays = counts.iter().sum();
+    stats.rays = counts.iter().sum::<u64>() + nodes.as_ref().map_or(0, |n| n.1);
     stats.rays_per_pixel = stats.rays as f64 / (width * height) as f64;
     stats.seconds = t0.elapsed().as_secs_f64();
     (

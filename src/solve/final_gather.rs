@@ -300,6 +300,7 @@ pub fn sensor_irradiance<I: Intersector>(
                 [1.0; 3],
                 ctx.rays,
                 true,
+                LightParts::All,
                 &mut rng,
             )
             .h
@@ -412,7 +413,17 @@ impl<I: Intersector> Ctx<'_, I> {
         let stream = GATHER_STREAM.wrapping_sub(REGATHER_STREAMS * round);
         let mut rng = rng_for(self.seed, stream, i as u64);
         let at = |u: f32, v: f32| points.at(u, v);
-        self.gather_at(i, &at, patch.normal, eps, self.rho[i], rays, true, &mut rng)
+        self.gather_at(
+            i,
+            &at,
+            patch.normal,
+            eps,
+            self.rho[i],
+            rays,
+            true,
+            LightParts::All,
+            &mut rng,
+        )
     }
 
     /// The gather at the points `at(u, v)` of the unit square's map (a patch's, or one
@@ -431,6 +442,7 @@ impl<I: Intersector> Ctx<'_, I> {
         rho: [f64; 3],
         rays_wanted: usize,
         lights: bool,
+        parts: LightParts,
         rng: &mut R,
     ) -> Gathered {
         let mesh = self.mesh;
@@ -440,20 +452,35 @@ impl<I: Intersector> Ctx<'_, I> {
         let mut var = 0.0;
         let mut rays = 0u64;
         // Half the rays to the emitters (when there are any), half over the hemisphere.
-        let n_direct = if self.emitters.is_empty() || !lights {
-            0
-        } else {
-            (rays_wanted / 2).max(1)
-        };
+        let lamps = !self.emitters.is_empty() && lights;
         let sun = self.sky.and_then(Sky::sun);
-        let n_sun = if sun.is_some() {
-            (rays_wanted / 4).max(1)
-        } else {
-            0
+        let (n_direct, n_sun) = match (parts, lamps, sun.is_some()) {
+            (LightParts::Indirect, _, _) => (0, 0),
+            (LightParts::All, l, s) => (
+                if l { (rays_wanted / 2).max(1) } else { 0 },
+                if s { (rays_wanted / 4).max(1) } else { 0 },
+            ),
+            // All the rays to the lights: two thirds to the emitters when there is a sun too.
+            (LightParts::Direct, true, true) => {
+                let d = (rays_wanted * 2 / 3).max(1);
+                (d, rays_wanted.saturating_sub(d).max(1))
+            }
+            (LightParts::Direct, true, false) => (rays_wanted.max(1), 0),
+            (LightParts::Direct, false, true) => (0, rays_wanted.max(1)),
+            (LightParts::Direct, false, false) => (0, 0),
         };
         let grid =
             PolarGrid::for_samples(rays_wanted.saturating_sub(n_direct + n_sun).max(2) as f64);
-        let (nl, nc) = (n_direct as f64, grid.len() as f64);
+        // The MIS weights (balance heuristic, by the counts of light and hemisphere samples).
+        // Split in two parts gathered apart, both weigh as if by equal counts (the split of
+        // `All` without a sun), so that the two weights of a path still add up to one: the
+        // light samples of `Direct` and the hemisphere rays of `Indirect` share each
+        // emitter's light, neither taking it all (light samples alone are unbounded beside an
+        // emitter, at a room's corner).
+        let (nl, nc) = match parts {
+            LightParts::All => (n_direct as f64, grid.len() as f64),
+            LightParts::Direct | LightParts::Indirect => (if lamps { 1.0 } else { 0.0 }, 1.0),
+        };
 
         // Direct: emitters by power, points on them uniform, shadow rays.
         if n_direct > 0 {
@@ -516,6 +543,9 @@ impl<I: Intersector> Ctx<'_, I> {
             var += stratified_var(&m);
         }
 
+        if parts == LightParts::Direct {
+            return Gathered { h, ch, var, rays };
+        }
         // Indirect: cosine-weighted rays through the polar cells, B − E of the side met.
         let x_count = grid.len();
         let angle = rng.gen::<f32>() * std::f32::consts::TAU;
@@ -843,6 +873,20 @@ impl<I: Intersector> Ctx<'_, I> {
             1.0
         }
     }
+}
+
+/// Which parts of the light a gather samples (the final-gather renderer gathers the indirect
+/// light at a few points of the image and interpolates it: [`PointGather::part_at`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightParts {
+    /// Everything: the emitters and the sun by shadow rays, the rest over the hemisphere, the
+    /// emitters met by hemisphere rays weighed against the light samples (MIS).
+    All,
+    /// The shadow rays alone: the emitters (at their MIS weight) and the sun.
+    Direct,
+    /// The hemisphere rays alone: what they meet, emitters at the complement of the weight
+    /// `Direct` gives them. `Direct` + `Indirect` is `All` in expectation.
+    Indirect,
 }
 
 /// A shadow ray's outcome: E_j·cosθ_i·cosθ_j/(π r²) (0 when not seen) and its geometry.
@@ -1400,8 +1444,28 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         rays: usize,
         rng: &mut R,
     ) -> ([f64; 3], u64) {
+        self.part_at(patch, points, rays, LightParts::All, rng)
+    }
+
+    /// [`Self::radiosity_at`]'s `parts` of the light: `All` is B = E + ρ·H; `Direct` is
+    /// E + ρ·H_direct (the emitters and the sun by shadow rays, all `rays` theirs); `Indirect`
+    /// is ρ·H_indirect (the hemisphere, the emitters' light left out). `Direct` and `Indirect`
+    /// add up to `All`'s B in expectation.
+    pub fn part_at<R: Rng>(
+        &self,
+        patch: usize,
+        points: &[Vec3],
+        rays: usize,
+        parts: LightParts,
+        rng: &mut R,
+    ) -> ([f64; 3], u64) {
         let ctx = &self.ctx;
         let (e, rho) = (ctx.e[patch], ctx.rho[patch]);
+        let e = if parts == LightParts::Indirect {
+            [0.0; 3]
+        } else {
+            e
+        };
         if points.is_empty() || scalar(&rho) <= 0.0 {
             return (e, 0);
         }
@@ -1410,7 +1474,17 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         let m = points.len();
         let at = |u: f32, _: f32| points[((u * m as f32) as usize).min(m - 1)];
         let lights = *self.facing[patch].get_or_init(|| self.lit_by_an_emitter(patch));
-        let g = ctx.gather_at(patch, &at, p.normal, eps, rho, rays.max(2), lights, rng);
+        let g = ctx.gather_at(
+            patch,
+            &at,
+            p.normal,
+            eps,
+            rho,
+            rays.max(2),
+            lights,
+            parts,
+            rng,
+        );
         let b = [0, 1, 2].map(|q| {
             let v = e[q] + rho[q] * g.h[q];
             if v.is_finite() {
@@ -1426,6 +1500,11 @@ impl<'a, I: Intersector> PointGather<'a, I> {
     /// (the unit of B), black without a sky; the sun's disc is left out.
     pub fn sky_exitance(&self, dir: Vec3) -> [f64; 3] {
         self.ctx.sky_exitance(dir)
+    }
+
+    /// The mesh the gather casts into.
+    pub fn mesh(&self) -> &Mesh {
+        self.ctx.mesh
     }
 }
 

@@ -6,7 +6,7 @@ use clap::Args;
 use glam::Vec3;
 use radiosity::intersect::select::IntersectorKind;
 use radiosity::mesh::MeshOptions;
-use radiosity::render::gather::DEFAULT_PIXEL_RAYS;
+use radiosity::render::gather::{DEFAULT_INDIRECT_SPACING, DEFAULT_PIXEL_RAYS};
 use radiosity::render::view::{image_size, DEFAULT_SUPERSAMPLE};
 use radiosity::render::view_file::RadianceView;
 use radiosity::render::{CameraSpec, RenderOptions, Shading, ShadingSettings, ViewSettings};
@@ -340,6 +340,11 @@ pub struct ShadingArgs {
     /// over the hemisphere); --supersample sets the samples per pixel.
     #[arg(long, default_value_t = DEFAULT_PIXEL_RAYS, value_name = "N")]
     pub pixel_rays: usize,
+    /// --shading gather: pixels between the points where the indirect light is gathered
+    /// (each with the hemisphere rays of several pixels) and interpolated from over one
+    /// surface; the direct light is still sampled at every pixel. 0: gathered at every sample.
+    #[arg(long, default_value_t = DEFAULT_INDIRECT_SPACING, value_name = "PIXELS")]
+    pub indirect_spacing: usize,
 }
 
 impl ShadingArgs {
@@ -350,6 +355,7 @@ impl ShadingArgs {
             shading: self.shading.map_or(default, Shading::from),
             rays: self.pixel_rays,
             seed,
+            indirect_spacing: self.indirect_spacing,
         }
     }
 }
