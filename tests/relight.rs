@@ -233,3 +233,129 @@ fn relight_from_the_command_line() {
     ]);
     assert_eq!(code, 2, "{err}");
 }
+
+/// Area-weighted radiosity of the elements per patch, Σ A_e·B_e over each patch's elements.
+fn element_flux(sol: &SavedSolution) -> Vec<f64> {
+    let el = sol.elements.as_ref().expect("elements");
+    let mut out = vec![0.0; sol.mesh.patches.len()];
+    for (e, &p) in el.patch.iter().enumerate() {
+        out[p as usize] += el.mesh.patches[e].area * scalar(&el.b[e]);
+    }
+    out
+}
+
+/// Σ |a − k·b| / Σ k·b: the area-weighted relative difference of two element solutions.
+fn relative_difference(a: &[f64], b: &[f64], k: f64) -> f64 {
+    let num: f64 = a.iter().zip(b).map(|(x, y)| (x - k * y).abs()).sum();
+    num / b.iter().map(|y| k * y).sum::<f64>()
+}
+
+/// A relit Gouraud picture and a relit mesh show the adaptive elements, refined again under
+/// the relit lights with the solve's element settings (here `--element-rays 32`): more mesh
+/// records than patches, and at weight 1 element values within 5 % (area-weighted) of the
+/// saved ones, at weight 0.5 half of them. A final-gather picture does not refine them; a
+/// solution solved `--elements off` stays without.
+#[test]
+fn relit_gouraud_and_meshes_refine_the_elements_again() {
+    use radiosity::progress::Progress;
+    use radiosity::saved::relight::{element_settings, relight_with_elements};
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).display().to_string();
+    let spot = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/spot.obj");
+    let spot = spot.to_str().unwrap();
+    for (file, extra) in [
+        ("s.rad", "--element-rays=32"),
+        ("off.rad", "--elements=off"),
+    ] {
+        let (code, _, err) = common::run(&[
+            "solve",
+            spot,
+            "--per-light",
+            "--tolerance",
+            "0.1",
+            extra,
+            "--shading",
+            "gouraud",
+            "--width",
+            "64",
+            "--height",
+            "48",
+            "--save",
+            &p(file),
+            "--out",
+            &p(&format!("{file}.out")),
+            "--quiet",
+        ]);
+        assert_eq!(code, 0, "{err}");
+    }
+    let saved = SavedSolution::load(Path::new(&p("s.rad"))).unwrap();
+    let patches = saved.mesh.patches.len();
+    let n_saved = saved.elements.as_ref().unwrap().mesh.patches.len();
+    assert!(n_saved > patches, "{n_saved} elements, {patches} patches");
+    let settings = element_settings(&saved).expect("the solve's element settings");
+    assert_eq!(settings.rays, 32);
+
+    // Weight 1: the saved elements again, within the corners' sampling noise; weight 0.5:
+    // half of them.
+    let progress = Progress::hidden();
+    let mut warnings = Vec::new();
+    let saved_flux = element_flux(&saved);
+    for w in [1.0, 0.5] {
+        let weights = [("light".to_string(), w)];
+        let (relit, stats) =
+            relight_with_elements(&saved, &weights, &progress, &mut warnings).expect("relight");
+        let stats = stats.expect("refined");
+        assert_eq!(stats.rays_per_corner, 32);
+        let n = relit.elements.as_ref().unwrap().mesh.patches.len();
+        assert!(n > patches, "weight {w}: {n} elements, {patches} patches");
+        let d = relative_difference(&element_flux(&relit), &saved_flux, w);
+        assert!(d < 0.05, "weight {w}: element values differ by {d}");
+    }
+    assert!(warnings.is_empty(), "{warnings:?}");
+
+    // From the command line: the report counts the elements drawn; the PLY has a face per
+    // element.
+    let report = |args: &[&str]| -> serde_json::Value {
+        let (code, out, err) = common::run(args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let (w, h) = (["--width", "64"], ["--height", "48"]);
+    let mut gouraud = vec!["relight", "--weight", "light=0.5", "--json"];
+    gouraud.extend(w.iter().chain(&h));
+    let rad = p("s.rad");
+    let png = p("r.png");
+    let r = report(&[&gouraud[..], &[&rad, "--shading", "gouraud", "--out", &png]].concat());
+    assert_eq!(r["patches"].as_u64(), Some(patches as u64));
+    assert!(r["elements"].as_u64().unwrap() > patches as u64, "{r}");
+    let ply = p("r.ply");
+    let r = report(&[
+        "relight",
+        &rad,
+        "--weight",
+        "light=0.5",
+        "--json",
+        "--out",
+        &ply,
+    ]);
+    let faces = r["elements"].as_u64().unwrap();
+    assert!(faces > patches as u64, "{r}");
+    let text = std::fs::read(&ply).unwrap();
+    let head = String::from_utf8_lossy(&text[..text.len().min(2000)]).to_string();
+    assert!(head.contains(&format!("element face {faces}\n")), "{head}");
+    // The final gather reads the patches: no elements refined.
+    let gather = p("g.png");
+    let r = report(&[&gouraud[..], &[&rad, "--pixel-rays", "4", "--out", &gather]].concat());
+    assert!(r.get("elements").is_none(), "{r}");
+    // Solved without elements: relit without them.
+    let off = SavedSolution::load(Path::new(&p("off.rad"))).unwrap();
+    assert!(element_settings(&off).is_none());
+    let r = report(
+        &[
+            &gouraud[..],
+            &[&p("off.rad"), "--shading", "gouraud", "--out", &png],
+        ]
+        .concat(),
+    );
+    assert!(r.get("elements").is_none(), "{r}");
+}

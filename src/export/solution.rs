@@ -138,8 +138,10 @@ pub struct SavedSolution {
     pub vertex_b: Vec<[f32; 3]>,
     /// Per-light channels; empty when the solve did not keep them.
     pub channels: Vec<LightChannel>,
-    /// The adaptive elements (format 2); `None` in a format-1 file, or after relighting (the
-    /// elements' gathered values are the saved lights'): the patches are shown then.
+    /// The adaptive elements (format 2); `None` in a format-1 file: the patches are shown
+    /// then. Relighting drops them (their gathered values are the saved lights') and, for an
+    /// output that shows them, refines them again under the relit lights
+    /// ([`crate::saved::relight::relight_with_elements`]).
     pub elements: Option<Elements>,
 }
 

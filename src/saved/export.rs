@@ -69,6 +69,7 @@ pub(crate) fn export_loaded(
         out: job.out.display().to_string(),
         format,
         patches: sol.mesh.patches.len(),
+        elements: sol.elements.as_ref().map(|e| e.mesh.patches.len()),
         vertices: mesh.vertices.len(),
         exposure: Some(exposure),
         scale: None,

@@ -40,6 +40,10 @@ pub struct OutputReport {
     pub out: String,
     pub format: String,
     pub patches: usize,
+    /// The adaptive elements drawn (a Gouraud picture, a mesh), when the solution has them;
+    /// none when the patches are (or the output draws no mesh).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elements: Option<usize>,
     pub vertices: usize,
     /// Exposure of the display colours, when the output has any.
     pub exposure: Option<f32>,

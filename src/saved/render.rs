@@ -76,6 +76,21 @@ pub fn saved_sky(sol: &SavedSolution) -> Result<Option<Sky>, String> {
     Sky::new(&spec).map(Some).map_err(|e| e.to_string())
 }
 
+/// [`saved_sky`], or none with a warning that says what `what` (a picture, the elements) then
+/// leaves out.
+pub(crate) fn saved_sky_or_warn(
+    sol: &SavedSolution,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Option<Sky> {
+    saved_sky(sol).unwrap_or_else(|e| {
+        warnings.push(format!(
+            "the solution's sky could not be rebuilt ({e}): {what} shows no sky or sun light arriving directly (the solution's own light, which includes the sky's, is still gathered)"
+        ));
+        None
+    })
+}
+
 /// The final-gather picture of a loaded (or relit) solution, and what it cost; the warnings a
 /// user should hear of (a sky that could not be rebuilt).
 pub(crate) fn gather_image(
@@ -90,12 +105,7 @@ pub(crate) fn gather_image(
     mesh.pair_twins();
     let (isect, _) = select::select(&mesh, IntersectorKind::Auto)?;
     let materials: Vec<_> = sol.meta.materials.iter().map(|m| m.material()).collect();
-    let sky = saved_sky(sol).unwrap_or_else(|e| {
-        warnings.push(format!(
-            "the solution's sky could not be rebuilt ({e}): the gathered picture shows no sky or sun light arriving directly (the solution's own light, which includes the sky's, is still gathered)"
-        ));
-        None
-    });
+    let sky = saved_sky_or_warn(sol, "the gathered picture", warnings);
     let gather = PointGather::new(&mesh, &materials, &isect, &sol.b, sky.as_ref(), relit);
     let rows = progress.start_count("rendering", u64::from(job.view.image.height));
     let out = render_gather(&gather, cam, &job.view.image, &job.shading, &rows);
@@ -117,6 +127,7 @@ pub(crate) fn render_loaded(
     let mut scale = None;
     let mut shading = None;
     let mut gathered = None;
+    let mut elements = None;
     let mut warnings = Vec::new();
     if job.false_colour {
         let (img, s) = false_colour::render(&sol.mesh, &sol.irradiance(), &cam, &job.view.image);
@@ -125,6 +136,7 @@ pub(crate) fn render_loaded(
     } else {
         let lin = match job.shading.shading {
             Shading::Gouraud => {
+                elements = sol.elements.as_ref().map(|e| e.mesh.patches.len());
                 let (mesh, vertex_b) = sol.display();
                 render::render_linear(mesh, vertex_b, &cam, &job.view.image)
             }
@@ -151,6 +163,7 @@ pub(crate) fn render_loaded(
         out: job.out.display().to_string(),
         format: format!("{kind:?}").to_lowercase(),
         patches: sol.mesh.patches.len(),
+        elements,
         vertices: sol.mesh.vertices.len(),
         exposure,
         scale,

@@ -133,8 +133,11 @@ fn print_report(r: &OutputReport, json: bool, quiet: bool) {
             (Some(s), None) => format!("{extra}; {s} shading"),
             _ => extra,
         };
+        let elements = r
+            .elements
+            .map_or(String::new(), |n| format!(", {n} elements"));
         outln!(
-            "{}: {} of {} ({} patches, {} vertices){extra}",
+            "{}: {} of {} ({} patches{elements}, {} vertices){extra}",
             r.out,
             r.format,
             r.scene,
