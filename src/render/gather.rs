@@ -34,6 +34,7 @@
 //! exposure, tone mapping and the image writers treat the two alike.
 
 use super::{Camera, LinearImage, RenderOptions};
+use crate::elements::refine::INSET;
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::progress::Counter;
@@ -174,12 +175,22 @@ struct Group {
     alone_weight: [f64; 3],
 }
 
+/// Where the light of a point seen on `patch` is gathered: moved [`INSET`] of the way towards
+/// the patch's centre, so that a point seen in a room's edge (where float rounding may put it
+/// a hair inside the wall beside it) casts no ray out of the room — at a node, such a ray
+/// would darken the 8 pixels around it.
+fn inset(mesh: &Mesh, patch: usize, point: Vec3) -> Vec3 {
+    point + (mesh.patches[patch].centre - point) * INSET as f32
+}
+
 /// The indirect light gathered at one node of the image: ρ·H_indirect of the side seen
 /// there, and which surface (polygon and facing) that side is.
 #[derive(Clone, Copy)]
 struct Node {
     polygon: u32,
+    material: u32,
     normal: Vec3,
+    point: Vec3,
     value: [f64; 3],
 }
 
@@ -222,7 +233,7 @@ impl Nodes {
                         let h = seen.hit?;
                         let (value, n) = gather.part_at(
                             h.patch,
-                            &[h.point],
+                            &[inset(mesh, h.patch, h.point)],
                             rays,
                             LightParts::Indirect,
                             &mut rng,
@@ -231,7 +242,9 @@ impl Nodes {
                         let p = &mesh.patches[h.patch];
                         Some(Node {
                             polygon: p.polygon,
+                            material: p.material,
                             normal: p.normal,
+                            point: h.point,
                             value,
                         })
                     })
@@ -252,10 +265,12 @@ impl Nodes {
         )
     }
 
-    /// The indirect light at image point (x, y) on `patch`, interpolated bilinearly from the
-    /// four nodes around it when all four saw the same surface (its polygon, facing alike);
-    /// `None` otherwise (an edge, a corner, another object between): gathered there instead.
-    fn interpolate(&self, mesh: &Mesh, patch: usize, x: f32, y: f32) -> Option<[f64; 3]> {
+    /// The indirect light at image point (x, y), the point `at` on `patch`, interpolated
+    /// bilinearly from those of the four nodes around it that saw the sample's surface — the
+    /// same material facing alike in the same plane (a polygon, or coplanar neighbours such
+    /// as a ceiling's tiles) — their weights renormalised; `None` when none did (an object's
+    /// edge seen against another): gathered there instead.
+    fn interpolate(&self, mesh: &Mesh, patch: usize, at: Vec3, x: f32, y: f32) -> Option<[f64; 3]> {
         let (gx, gy) = (x / self.spacing, y / self.spacing);
         let (i, j) = (gx.floor() as usize, gy.floor() as usize);
         if i + 1 >= self.cols || j + 1 >= self.rows {
@@ -263,22 +278,32 @@ impl Nodes {
         }
         let (tx, ty) = (f64::from(gx - i as f32), f64::from(gy - j as f32));
         let p = &mesh.patches[patch];
-        let mut v = [0.0; 3];
+        let (mut v, mut total) = ([0.0; 3], 0.0);
         for (di, dj, w) in [
             (0, 0, (1.0 - tx) * (1.0 - ty)),
             (1, 0, tx * (1.0 - ty)),
             (0, 1, (1.0 - tx) * ty),
             (1, 1, tx * ty),
         ] {
-            let n = self.at[(j + dj) * self.cols + i + di]?;
-            if n.polygon != p.polygon || n.normal.dot(p.normal) < 0.999 {
-                return None;
+            let Some(n) = self.at[(j + dj) * self.cols + i + di] else {
+                continue;
+            };
+            let same = n.polygon == p.polygon
+                || (n.material == p.material && {
+                    let d = n.point - at;
+                    p.normal.dot(d).abs() <= 1e-3 * d.length() + 1e-6
+                });
+            if !same || n.normal.dot(p.normal) < 0.999 {
+                continue;
             }
+            // Never a zero weight for a node that counts (a sample exactly on a node line).
+            let w = w + 1e-9;
+            total += w;
             for (x, y) in v.iter_mut().zip(n.value) {
                 *x += w * y;
             }
         }
-        Some(v)
+        (total > 0.0).then(|| v.map(|x| x / total))
     }
 }
 
@@ -363,17 +388,18 @@ pub fn render_gather<I: Intersector>(
                                 }
                             };
                             let g = &mut groups[at];
-                            g.points.push(h.point);
+                            let x = inset(mesh, h.patch, h.point);
+                            g.points.push(x);
                             for q in 0..3 {
                                 g.weight[q] += seen.through[q];
                             }
                             let ind = nodes
                                 .as_ref()
-                                .and_then(|(n, _)| n.interpolate(mesh, h.patch, fx, fy));
+                                .and_then(|(n, _)| n.interpolate(mesh, h.patch, h.point, fx, fy));
                             match ind {
                                 Some(v) => add(&mut sum, v, seen.through),
                                 None => {
-                                    g.alone.push(h.point);
+                                    g.alone.push(x);
                                     for q in 0..3 {
                                         g.alone_weight[q] += seen.through[q];
                                     }
