@@ -148,12 +148,30 @@ fn gather_rays_within(
     stats: &SolveStats,
     start: Instant,
 ) -> Option<usize> {
-    let rays = cfg.gather_rays_per_patch();
+    let elapsed = start.elapsed().as_secs_f64();
+    gather_rays_fitting(
+        cfg,
+        cfg.gather_rays_per_patch(),
+        patches,
+        stats.rays as f64,
+        elapsed,
+    )
+}
+
+/// [`gather_rays_within`]'s rule for `rays` wanted per patch, after `shot` shooting rays in
+/// `elapsed` seconds (the rate the time left is spent at); the error target's later passes
+/// and gather rounds (`passes`) keep to `--max-time` by it too.
+pub(super) fn gather_rays_fitting(
+    cfg: &SolveSettings,
+    rays: usize,
+    patches: usize,
+    shot: f64,
+    elapsed: f64,
+) -> Option<usize> {
     let Some(limit) = cfg.max_time else {
         return Some(rays);
     };
-    let elapsed = start.elapsed().as_secs_f64();
-    let rate = stats.rays as f64 / elapsed.max(1e-9);
+    let rate = shot / elapsed.max(1e-9);
     let fits = (limit - elapsed).max(0.0) * rate / (GATHER_RAY_COST * patches.max(1) as f64);
     if fits >= rays as f64 {
         Some(rays)

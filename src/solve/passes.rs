@@ -365,6 +365,14 @@ pub(super) fn shoot_to<I: Intersector>(
         };
         let shoot_cost = rays + first_gather_rays * (so_far + rays) / r1;
         if let (Some(isect), Some(plan)) = (gather, plan.filter(|pl| pl.rays < shoot_cost)) {
+            // Under --max-time, a round that does not fit in the time left is not begun.
+            let elapsed = start.elapsed().as_secs_f64();
+            let cast = trace.last().map_or(so_far, |t| t.rays as f64);
+            let want = plan.rays.ceil() as usize;
+            if super::driver::gather_rays_fitting(cfg, want, 1, cast, elapsed) != Some(want) {
+                out.stats.stop_reason = Some(StopReason::MaxTime);
+                break;
+            }
             let b = base.take().expect("planned from it");
             let (sol, em, nb) = gathered(
                 mesh,
@@ -409,11 +417,26 @@ pub(super) fn shoot_to<I: Intersector>(
             out.stats.stop_reason = sol.stats.stop_reason;
             break;
         }
+        // Its gather, under --max-time cut to the rays that fit; when not even the fewest do,
+        // the pass is left out as a pass cut short is.
+        let mut scale = (so_far + samples(&sol)) / r1;
+        if gather.is_some() {
+            let wanted = (cfg.gather_rays_per_patch() as f64 * scale).round() as usize;
+            let elapsed = start.elapsed().as_secs_f64();
+            let cast = so_far + samples(&sol);
+            match super::driver::gather_rays_fitting(cfg, wanted, mesh.patches.len(), cast, elapsed)
+            {
+                Some(r) => scale = scale * r as f64 / wanted.max(1) as f64,
+                None => {
+                    out.stats.stop_reason = Some(StopReason::MaxTime);
+                    break;
+                }
+            }
+        }
         sols.push(sol);
         let combined = combine(mesh, &area, &emission, &sols);
         (out, m) = match gather {
             Some(isect) => {
-                let scale = sols.iter().map(samples).sum::<f64>() / r1;
                 let (pre, _, parts) = combined;
                 let (sol, em, b) =
                     gathered(mesh, materials, isect, cfg, hooks, pre, parts, scale, None);
