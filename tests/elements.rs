@@ -128,7 +128,7 @@ fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
     assert!(along > 0.9 * 4.0 * 1.2 && far > 0, "{along} {far}");
 }
 
-/// Ctrl-C before the refinement: each patch is kept whole (the spot's patches are quads),
+/// Ctrl-C (or `--max-time`'s deadline) before the refinement: each patch is kept whole (the spot's patches are quads),
 /// with its corners gathered, and the stats say so.
 #[test]
 fn ctrl_c_keeps_what_is_refined() {
@@ -138,10 +138,22 @@ fn ctrl_c_keeps_what_is_refined() {
     let gather = PointGather::new(&m, &s.materials, &isect, &sol.b, None, None);
     let stop = std::sync::atomic::AtomicBool::new(true);
     let settings = ElementSettings::default();
-    let (el, st) = elements::refine_until(&m, &gather, &sol.b, &settings, 7, Some(&stop));
+    let ctrl_c = elements::Stop {
+        flag: Some(&stop),
+        deadline: None,
+    };
+    let (el, st) = elements::refine_until(&m, &gather, &sol.b, &settings, 7, ctrl_c);
     assert!(st.interrupted, "{st:?}");
     assert_eq!(st.count as usize, m.patches.len());
     assert!(el.b.iter().flatten().all(|x| x.is_finite() && *x >= 0.0));
+    // A deadline passed (--max-time) does the same.
+    let late = elements::Stop {
+        flag: None,
+        deadline: Some(std::time::Instant::now()),
+    };
+    let (_, st) = elements::refine_until(&m, &gather, &sol.b, &settings, 7, late);
+    assert!(st.out_of_time && !st.interrupted, "{st:?}");
+    assert_eq!(st.count as usize, m.patches.len());
     let (_, full) = elements::refine(&m, &gather, &sol.b, &settings, 7);
     assert!(!full.interrupted && full.count > st.count, "{full:?}");
 }

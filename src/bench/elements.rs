@@ -171,7 +171,7 @@ pub fn run(
         job.reference_rays,
         usize::MAX,
         seed,
-        None,
+        Default::default(),
     );
     log(&format!(
         "reference: {} elements, {} rays, {:.1} s",
@@ -188,7 +188,7 @@ pub fn run(
             job.rays,
             usize::MAX,
             seed,
-            None,
+            Default::default(),
         );
         let (error, energy_error) = error_against(model, &reference, &el, unlit);
         log(&format!(
@@ -220,7 +220,15 @@ pub fn run(
             min_size,
             test,
         };
-        let (el, st) = elements::refine_by(m, &gather, rule, job.rays, usize::MAX, seed, None);
+        let (el, st) = elements::refine_by(
+            m,
+            &gather,
+            rule,
+            job.rays,
+            usize::MAX,
+            seed,
+            Default::default(),
+        );
         let (error, energy_error) = error_against(model, &reference, &el, unlit);
         log(&format!(
             "adaptive {test:?} threshold {threshold}: {} elements, error {:.2} % (energy {:.2} %), {:.2} s",

@@ -32,10 +32,9 @@ use crate::solve::scalar;
 use geometry::Elem;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-pub use refine::{Rule, Test};
+pub use refine::{Rule, Stop, Test};
 
 /// Default `--element-threshold` ([`Test::Halves`]): an element is cut while the error of
 /// its interpolation, relative to its mean and weighed by its share of its patch, exceeds
@@ -51,11 +50,10 @@ pub const DEFAULT_RAYS: usize = 256;
 /// Default cap on the elements, as a multiple of the patches.
 pub const DEFAULT_MAX_FACTOR: f64 = 8.0;
 /// `--elements auto` (the default) refines the elements of meshes up to this many patches
-/// and skips them, with a line, above: their cost grows with the patches (6.0 s for the
-/// 5,267-patch church on 2 cores, about 1 ms a patch; at 128 rays Sibenik's 100,412 patches
-/// took 33 CPU s on top of its 35 CPU s solve), so a big model's picture is the final
-/// gather's.
-pub const AUTO_MAX_PATCHES: u64 = 25_000;
+/// and skips them, with a line, above: their cost grows with the patches, about 1.1–1.3 ms a
+/// patch on 2 cores (6.0 s for the 5,267-patch church; 28.6 s for the furnished office's
+/// 21,801 patches, whose solve takes 20 s), so a big model's picture is the final gather's.
+pub const AUTO_MAX_PATCHES: u64 = 10_000;
 /// Below this fraction of the scene's mean radiosity, differences count as if at it (dark
 /// corners are not refined for noise).
 pub const FLOOR: f64 = 1e-3;
@@ -165,6 +163,9 @@ pub struct ElementStats {
     /// Whether Ctrl-C stopped it (the elements refined by then are kept).
     #[serde(default)]
     pub interrupted: bool,
+    /// Whether `--max-time` stopped it (likewise).
+    #[serde(default)]
+    pub out_of_time: bool,
 }
 
 /// The element mesh of a solution: what is shown and exported.
@@ -287,17 +288,17 @@ pub fn refine<I: Intersector>(
     settings: &ElementSettings,
     seed: u64,
 ) -> (Elements, ElementStats) {
-    refine_until(mesh, gather, b, settings, seed, None)
+    refine_until(mesh, gather, b, settings, seed, Stop::default())
 }
 
-/// [`refine()`], stopping early (keeping what is refined) once `stop` is set (Ctrl-C).
+/// [`refine()`], stopping early (keeping what is refined) on Ctrl-C or at a deadline.
 pub fn refine_until<I: Intersector>(
     mesh: &Mesh,
     gather: &PointGather<'_, I>,
     b: &[[f64; 3]],
     settings: &ElementSettings,
     seed: u64,
-    stop: Option<&AtomicBool>,
+    stop: Stop<'_>,
 ) -> (Elements, ElementStats) {
     let min_size = settings.min_size_for(mesh.patch_size) as f64;
     let rule = Rule::Adaptive {
@@ -314,7 +315,7 @@ pub fn refine_until<I: Intersector>(
 }
 
 /// [`refine()`] by any [`Rule`] (the uniform meshing it is measured against), with `rays` per
-/// corner and at most `cap` elements, stopping early once `stop` is set.
+/// corner and at most `cap` elements, stopping early as `stop` says.
 pub fn refine_by<I: Intersector>(
     mesh: &Mesh,
     gather: &PointGather<'_, I>,
@@ -322,7 +323,7 @@ pub fn refine_by<I: Intersector>(
     rays: usize,
     cap: usize,
     seed: u64,
-    stop: Option<&AtomicBool>,
+    stop: Stop<'_>,
 ) -> (Elements, ElementStats) {
     let t = Instant::now();
     let (lo, hi) = mesh.vertices.iter().fold(
@@ -355,7 +356,8 @@ pub fn refine_by<I: Intersector>(
         min_size: 0.0,
         rays_per_corner: rays as u64,
         capped,
-        interrupted: r.stopped(),
+        interrupted: stop.interrupted(),
+        out_of_time: stop.out_of_time(),
     };
     (el, stats)
 }

@@ -93,8 +93,30 @@ pub(super) struct Refiner<'a, I> {
     pub seed: u64,
     pub rays: usize,
     pub quantum: f64,
-    /// Set on Ctrl-C: refine no further (what is refined is kept).
-    pub stop: Option<&'a std::sync::atomic::AtomicBool>,
+    /// Ctrl-C and `--max-time`: refine no further (what is refined is kept).
+    pub stop: Stop<'a>,
+}
+
+/// What ends a refinement early, keeping what is refined: Ctrl-C's flag, and the deadline
+/// `--max-time` sets.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Stop<'a> {
+    pub flag: Option<&'a std::sync::atomic::AtomicBool>,
+    pub deadline: Option<std::time::Instant>,
+}
+
+impl Stop<'_> {
+    /// Whether Ctrl-C was pressed.
+    pub fn interrupted(&self) -> bool {
+        self.flag
+            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+    }
+
+    /// Whether the deadline has passed.
+    pub fn out_of_time(&self) -> bool {
+        self.deadline
+            .is_some_and(|d| std::time::Instant::now() >= d)
+    }
 }
 
 /// The cache key of a position.
@@ -104,10 +126,9 @@ pub(super) fn key(p: DVec3, quantum: f64) -> [i64; 3] {
 }
 
 impl<I: Intersector> Refiner<'_, I> {
-    /// Whether Ctrl-C asked to stop.
+    /// Whether Ctrl-C or the deadline asks to stop.
     pub fn stopped(&self) -> bool {
-        self.stop
-            .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed))
+        self.stop.interrupted() || self.stop.out_of_time()
     }
 
     /// The radiosity at corner `p` of patch `patch`, gathered once (Cohen 1986 Sec. 3, with a
@@ -271,8 +292,8 @@ impl<I: Intersector> Refiner<'_, I> {
 
 /// Runs the refinement of every patch to its fixed point under `rule`, with at most `cap`
 /// elements in all (the candidates with the largest contrast are cut first; patch order
-/// breaks ties). Returns each patch's work and whether the cap stopped it. Ctrl-C
-/// ([`Refiner::stop`]) ends it at the next patch, keeping what is refined.
+/// breaks ties). Returns each patch's work and whether the cap stopped it. Ctrl-C or the
+/// deadline ([`Refiner::stop`]) ends it at the next patch, keeping what is refined.
 pub(super) fn run<I: Intersector>(
     r: &Refiner<'_, I>,
     rule: Rule,

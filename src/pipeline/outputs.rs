@@ -110,13 +110,18 @@ pub fn write(
         }
         None => None,
     };
-    // A solve Ctrl-C stopped writes what it has at once: its patches, not elements.
-    let interrupted = job
-        .interrupt
-        .as_ref()
-        .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
+    // The elements keep to what is left of --max-time (counted from the run's start); a solve
+    // Ctrl-C stopped, or one with no time left, writes what it has at once: its patches.
+    let stop = elements::Stop {
+        flag: job.interrupt.as_deref(),
+        deadline: job
+            .settings
+            .solve
+            .max_time
+            .map(|t| run.t0 + std::time::Duration::from_secs_f64(t.max(0.0))),
+    };
     let (elements, element_stats) = match isect {
-        Some(isect) if refine && !interrupted => {
+        Some(isect) if refine && !stop.interrupted() && !stop.out_of_time() => {
             run.progress.phase("refining elements");
             let gather = crate::solve::final_gather::PointGather::new(
                 m,
@@ -132,7 +137,7 @@ pub fn write(
                 &sol.b,
                 &job.settings.elements,
                 job.settings.solve.seed,
-                job.interrupt.as_deref(),
+                stop,
             );
             log(&format!(
                 "elements: {} from {} patches (threshold {}, min size {:.4} m), {} rays, {:.2} s",
@@ -140,6 +145,8 @@ pub fn write(
             ));
             if st.interrupted {
                 log("interrupted: the elements refined so far are kept");
+            } else if st.out_of_time {
+                log("--max-time reached: the elements refined so far are kept");
             }
             if st.capped {
                 log(&format!(
