@@ -484,28 +484,7 @@ fn relight_gathers_the_reweighted_lights() {
 fn a_saved_daylit_solve_renders_with_its_sky() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    // A 2 × 1 × 2 m room without a roof, faces wound to look in.
-    let obj = d.join("court.obj");
-    std::fs::write(
-        &obj,
-        "mtllib c.mtl\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 0 0 2\nv 2 0 2\nv 2 1 2\nv 0 1 2\n\
-         usemtl stone\nf 1 5 6 2\nf 1 2 3 4\nf 5 8 7 6\nf 1 4 8 5\nf 2 6 7 3\n",
-    )
-    .unwrap();
-    std::fs::write(d.join("c.mtl"), "newmtl stone\nKd 0.5 0.5 0.5\n").unwrap();
-    let sol = d.join("s.rad");
-    let (code, _, err) = run(&[
-        "solve",
-        s(&obj),
-        "--sky",
-        "uniform",
-        "--out",
-        s(&d.join("o")),
-        "--save",
-        s(&sol),
-        "--quiet",
-    ]);
-    assert_eq!(code, 0, "{err}");
+    let sol = solved_court(d, 0.5, &["--sky", "uniform"]);
     let out = d.join("up.exr");
     let (code, stdout, err) = run(&[
         "render",
@@ -539,4 +518,69 @@ fn a_saved_daylit_solve_renders_with_its_sky() {
         let p = img.get_pixel(x, y).0;
         assert!((p[1] / sky[1] - 1.0).abs() < 1e-3, "{p:?} against {sky:?}");
     }
+}
+
+/// Under a sky with a sun (no lamp), the indirect light gathered at nodes (the default) and at
+/// every sample (`--indirect-spacing 0`) give the same picture on average: the nodes' part is
+/// the hemisphere's (sky and bounced light), the samples' the sun's.
+#[test]
+fn a_sunlit_court_renders_alike_with_and_without_nodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sol = solved_court(d, 0.6, &["--sky", "clear", "--sun", "40,20"]);
+    let mean = |spacing: &str| {
+        let out = d.join(format!("v{spacing}.exr"));
+        let (code, _, err) = run(&[
+            "render",
+            s(&sol),
+            "--out",
+            s(&out),
+            "--eye",
+            "1,0.8,1.9",
+            "--target",
+            "1,0.2,0",
+            "--fov",
+            "80",
+            "--width",
+            "48",
+            "--height",
+            "36",
+            "--indirect-spacing",
+            spacing,
+        ]);
+        assert_eq!(code, 0, "{err}");
+        let img = image::open(&out).unwrap().to_rgb32f();
+        img.pixels().map(|p| f64::from(p.0[1])).sum::<f64>() / img.pixels().len() as f64
+    };
+    let (nodes, each) = (mean("4"), mean("0"));
+    eprintln!("court: nodes {nodes}, every sample {each}");
+    assert!(
+        each > 0.0 && (nodes / each - 1.0).abs() < 0.03,
+        "{nodes} against {each}"
+    );
+}
+
+/// A 2 × 1 × 2 m room without a roof (faces wound to look in) of reflectance `kd`, in `d`,
+/// solved under the sky `sky` and saved: the solution's path.
+fn solved_court(d: &Path, kd: f64, sky: &[&str]) -> std::path::PathBuf {
+    let obj = d.join("court.obj");
+    std::fs::write(
+        &obj,
+        "mtllib c.mtl\nv 0 0 0\nv 2 0 0\nv 2 1 0\nv 0 1 0\nv 0 0 2\nv 2 0 2\nv 2 1 2\nv 0 1 2\n\
+         usemtl stone\nf 1 5 6 2\nf 1 2 3 4\nf 5 8 7 6\nf 1 4 8 5\nf 2 6 7 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("c.mtl"),
+        format!("newmtl stone\nKd {kd} {kd} {kd}\n"),
+    )
+    .unwrap();
+    let sol = d.join("s.rad");
+    let (o, out) = (d.join("o"), s(&sol).to_string());
+    let mut args = vec!["solve", s(&obj)];
+    args.extend_from_slice(sky);
+    args.extend_from_slice(&["--out", s(&o), "--save", &out, "--quiet"]);
+    let (code, _, err) = run(&args);
+    assert_eq!(code, 0, "{err}");
+    sol
 }

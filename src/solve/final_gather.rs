@@ -523,7 +523,7 @@ impl<I: Intersector> Ctx<'_, I> {
         }
 
         // The sun: directions over its disc, shadow rays to the sky.
-        if let Some(sun) = sun {
+        if let Some(sun) = sun.filter(|_| n_sun > 0) {
             let (mut m, mut sum) = (Vec::with_capacity(n_sun), [0.0f64; 3]);
             let here = latin(n_sun, false, rng);
             let there = latin(n_sun, true, rng);
