@@ -40,7 +40,7 @@ use crate::mesh::Mesh;
 use crate::progress::Counter;
 use crate::settings::Invalid;
 use crate::solve::final_gather::{LightParts, PointGather};
-use crate::solve::rng_for;
+use crate::solve::{rng_for, scalar};
 use glam::Vec3;
 use rand::Rng;
 use rayon::prelude::*;
@@ -63,6 +63,13 @@ pub const MAX_INDIRECT_SPACING: usize = 64;
 
 /// A node gathers this many times the hemisphere rays of one pixel's samples.
 pub const NODE_GAIN: usize = 4;
+
+/// A node whose gather's relative standard error exceeds this gathers more rays, up to
+/// [`NODE_MORE`] times its first (as many as its measured variance says would bring it here).
+pub const NODE_ERROR: f64 = 0.02;
+
+/// At most this many times a node's first rays in all.
+pub const NODE_MORE: usize = 4;
 
 /// Most rays per sample `--pixel-rays` takes.
 pub const MAX_PIXEL_RAYS: usize = 65_536;
@@ -231,14 +238,32 @@ impl Nodes {
                         let seen = gather.view(org, dir);
                         cast += seen.rays;
                         let h = seen.hit?;
-                        let (value, n) = gather.part_at(
+                        let x = inset(mesh, h.patch, h.point);
+                        let (mut value, var, n) = gather.part_and_variance_at(
                             h.patch,
-                            &[inset(mesh, h.patch, h.point)],
+                            &[x],
                             rays,
                             LightParts::Indirect,
                             &mut rng,
                         );
                         cast += n;
+                        // A noisy node (daylight through a window: a bright patch of sky
+                        // few hemisphere rays find) gathers more, pooled by rays.
+                        let rel = var.sqrt() / scalar(&value).max(f64::MIN_POSITIVE);
+                        let more = ((rel / NODE_ERROR).powi(2) - 1.0).min(NODE_MORE as f64 - 1.0);
+                        let extra = (more * rays as f64).round() as usize;
+                        if extra >= 2 {
+                            let (v, n) = gather.part_at(
+                                h.patch,
+                                &[x],
+                                extra,
+                                LightParts::Indirect,
+                                &mut rng,
+                            );
+                            cast += n;
+                            let w = extra as f64 / (rays + extra) as f64;
+                            value = [0, 1, 2].map(|q| value[q] * (1.0 - w) + v[q] * w);
+                        }
                         let p = &mesh.patches[h.patch];
                         Some(Node {
                             polygon: p.polygon,

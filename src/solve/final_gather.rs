@@ -1459,6 +1459,20 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         parts: LightParts,
         rng: &mut R,
     ) -> ([f64; 3], u64) {
+        let (b, _, rays) = self.part_and_variance_at(patch, points, rays, parts, rng);
+        (b, rays)
+    }
+
+    /// [`Self::part_at`], with the variance of the scalar ρ·H it gathered (of its mean; 0
+    /// where nothing was gathered).
+    pub fn part_and_variance_at<R: Rng>(
+        &self,
+        patch: usize,
+        points: &[Vec3],
+        rays: usize,
+        parts: LightParts,
+        rng: &mut R,
+    ) -> ([f64; 3], f64, u64) {
         let ctx = &self.ctx;
         let (e, rho) = (ctx.e[patch], ctx.rho[patch]);
         let e = if parts == LightParts::Indirect {
@@ -1467,7 +1481,7 @@ impl<'a, I: Intersector> PointGather<'a, I> {
             e
         };
         if points.is_empty() || scalar(&rho) <= 0.0 {
-            return (e, 0);
+            return (e, 0.0, 0);
         }
         let p = &ctx.mesh.patches[patch];
         let eps = (1e-4 * (p.area as f32).sqrt()).max(ctx.eps_floor);
@@ -1493,7 +1507,8 @@ impl<'a, I: Intersector> PointGather<'a, I> {
                 0.0
             }
         });
-        (b, g.rays)
+        let var = if g.var.is_finite() { g.var } else { 0.0 };
+        (b, var, g.rays)
     }
 
     /// What a camera ray that leaves the model sees: the sky's radiance as an exitance, π·L
