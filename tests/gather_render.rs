@@ -149,6 +149,28 @@ fn indirect_nodes_keep_the_mean_and_lower_the_noise() {
     assert!(err_nodes < err_each, "{err_nodes} against {err_each}");
 }
 
+/// The aft clipping plane (`-va`, [`Camera::far`]): what lies beyond it is black in the
+/// gathered picture, as in the Gouraud one and in `rpict`'s, and what lies before it is drawn.
+#[test]
+fn the_aft_plane_clips_the_gathered_picture() {
+    let (scene, m, b) = shadow_room();
+    // From the middle of one wall towards the opposite one, 4 m away; the aft plane at 3 m.
+    let mut cam = Camera::perspective(vec3(2.0, 1.5, 0.1), vec3(2.0, 1.5, 4.0), Vec3::Y, 60.0, 1.0);
+    cam.far = Some(3.0);
+    let o = opts(24, 24, 1);
+    let img = gathered(&scene, &m, &b, &cam, &o, &gather_settings(8, 1));
+    let flat = render_linear(&m, &m.vertex_values(&b), &cam, &o);
+    // The centre sees the far wall (3.9 m on): clipped; a corner sees the floor near the eye.
+    let centre = luminance(&img.pixels[12 * 24 + 12]);
+    let corner = luminance(&img.pixels[23 * 24]);
+    assert_eq!(centre, 0.0);
+    assert_eq!(luminance(&flat.pixels[12 * 24 + 12]), 0.0);
+    assert!(corner > 0.0, "{corner}");
+    cam.far = None;
+    let open = gathered(&scene, &m, &b, &cam, &o, &gather_settings(8, 1));
+    assert!(luminance(&open.pixels[12 * 24 + 12]) > 0.0);
+}
+
 /// A view of [`shadow_room`] from high in one corner, of aspect `aspect`.
 fn room_camera(aspect: f32) -> Camera {
     Camera::perspective(

@@ -375,6 +375,7 @@ pub fn render_gather<I: Intersector>(
         )
     });
     let mesh = gather.mesh();
+    let far = camera.far_distance();
     let counts: Vec<u64> = pixels
         .par_chunks_mut(width)
         .enumerate()
@@ -396,6 +397,15 @@ pub fn render_gather<I: Intersector>(
                     };
                     let seen = gather.view(org, dir);
                     cast += seen.rays;
+                    // Beyond the aft plane (`-va`) nothing is seen, the sky neither, as the
+                    // Gouraud picture and rpict draw it.
+                    let beyond = |f: f32| {
+                        seen.hit
+                            .is_none_or(|h| camera.project(h.point).is_none_or(|(_, z)| z > f))
+                    };
+                    if far.is_some_and(beyond) {
+                        continue;
+                    }
                     add(&mut sum, seen.panes, [1.0; 3]);
                     match seen.hit {
                         Some(h) => {
