@@ -274,9 +274,7 @@ pub fn sensor_irradiance<I: Intersector>(
     rays: usize,
     seed: u64,
 ) -> Vec<[f64; 3]> {
-    let mat = |i: usize| &materials[mesh.patches[i].material as usize];
-    let e: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).emission()).collect();
-    let rho: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).rho).collect();
+    let (e, rho) = emission_and_reflectance(mesh, materials);
     let inputs = Inputs {
         e: Cow::Owned(e),
         rho: Cow::Owned(rho),
@@ -875,6 +873,15 @@ impl<I: Intersector> Ctx<'_, I> {
     }
 }
 
+/// Each patch's emission E and reflectance ρ (RGB), from its material.
+fn emission_and_reflectance(mesh: &Mesh, materials: &[Material]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+    let mat = |p: &crate::mesh::Patch| &materials[p.material as usize];
+    mesh.patches
+        .iter()
+        .map(|p| (mat(p).emission(), mat(p).rho))
+        .unzip()
+}
+
 /// Which parts of the light a gather samples (the final-gather renderer gathers the indirect
 /// light at a few points of the image and interpolates it: [`PointGather::part_at`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -1072,9 +1079,7 @@ pub fn apply<I: Intersector>(
 ) -> Gathers {
     let t0 = Instant::now();
     let np = mesh.patches.len();
-    let mat = |i: usize| &materials[mesh.patches[i].material as usize];
-    let e: Vec<[f64; 3]> = (0..np).map(|i| mat(i).emission()).collect();
-    let rho: Vec<[f64; 3]> = (0..np).map(|i| mat(i).rho).collect();
+    let (e, rho) = emission_and_reflectance(mesh, materials);
     let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
     let reflected = |b: &[[f64; 3]], i: usize| scalar(&b[i]) - scalar(&e[i]);
     let black = |b: &[[f64; 3]]| {
@@ -1339,16 +1344,11 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         sky: Option<&'a Sky>,
         relit: Option<Relit>,
     ) -> Self {
-        let mat = |i: usize| &materials[mesh.patches[i].material as usize];
+        let (own, rho) = emission_and_reflectance(mesh, materials);
         let (e, sky_weight, sun_weight) = match relit {
             Some(r) if r.emission.len() == mesh.patches.len() => (r.emission, r.sky, r.sun),
-            _ => (
-                (0..mesh.patches.len()).map(|i| mat(i).emission()).collect(),
-                1.0,
-                1.0,
-            ),
+            _ => (own, 1.0, 1.0),
         };
-        let rho: Vec<[f64; 3]> = (0..mesh.patches.len()).map(|i| mat(i).rho).collect();
         let inputs = Inputs {
             e: Cow::Owned(e),
             rho: Cow::Owned(rho),
