@@ -164,15 +164,19 @@ pub fn run(
         m.patches.len(),
         job.reference_rays
     ));
-    let (reference, rs) = elements::refine_by(
-        m,
-        &gather,
-        Rule::Uniform(ref_depth),
-        job.reference_rays,
-        usize::MAX,
-        seed,
-        Default::default(),
-    );
+    // Every patch cut to `depth`, `rays` per corner.
+    let uniform = |depth: u32, rays: usize| {
+        elements::refine_by(
+            m,
+            &gather,
+            Rule::Uniform(depth),
+            rays,
+            usize::MAX,
+            seed,
+            Default::default(),
+        )
+    };
+    let (reference, rs) = uniform(ref_depth, job.reference_rays);
     log(&format!(
         "reference: {} elements, {} rays, {:.1} s",
         rs.count, rs.rays, rs.seconds
@@ -181,15 +185,7 @@ pub fn run(
     let unlit = UNLIT * elements::mean_radiosity(m, &sol.b);
     let mut rows = Vec::new();
     for d in 0..=depth {
-        let (el, st) = elements::refine_by(
-            m,
-            &gather,
-            Rule::Uniform(d),
-            job.rays,
-            usize::MAX,
-            seed,
-            Default::default(),
-        );
+        let (el, st) = uniform(d, job.rays);
         let (error, energy_error) = error_against(model, &reference, &el, unlit);
         log(&format!(
             "uniform depth {d}: {} elements, error {:.2} % (energy {:.2} %), {:.2} s",

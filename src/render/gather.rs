@@ -239,13 +239,8 @@ impl Nodes {
                         cast += seen.rays;
                         let h = seen.hit?;
                         let x = inset(mesh, h.patch, h.point);
-                        let (mut value, var, n) = gather.part_and_variance_at(
-                            h.patch,
-                            &[x],
-                            rays,
-                            LightParts::Indirect,
-                            &mut rng,
-                        );
+                        let (mut value, var, n) =
+                            gather.part_at(h.patch, &[x], rays, LightParts::Indirect, &mut rng);
                         cast += n;
                         // A noisy node (daylight through a window: a bright patch of sky
                         // few hemisphere rays find) gathers more, pooled by rays.
@@ -253,7 +248,7 @@ impl Nodes {
                         let more = ((rel / NODE_ERROR).powi(2) - 1.0).min(NODE_MORE as f64 - 1.0);
                         let extra = (more * rays as f64).round() as usize;
                         if extra >= 2 {
-                            let (v, n) = gather.part_at(
+                            let (v, _, n) = gather.part_at(
                                 h.patch,
                                 &[x],
                                 extra,
@@ -458,7 +453,7 @@ pub fn render_gather<I: Intersector>(
                         add(&mut sum, b, g.weight);
                         continue;
                     }
-                    let (b, n) = gather.part_at(
+                    let (b, _, n) = gather.part_at(
                         g.patch,
                         &g.points,
                         half * g.points.len(),
@@ -468,7 +463,7 @@ pub fn render_gather<I: Intersector>(
                     cast += n;
                     add(&mut sum, b, g.weight);
                     if !g.alone.is_empty() {
-                        let (b, n) = gather.part_at(
+                        let (b, _, n) = gather.part_at(
                             g.patch,
                             &g.alone,
                             half * g.alone.len(),

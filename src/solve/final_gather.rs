@@ -1444,28 +1444,16 @@ impl<'a, I: Intersector> PointGather<'a, I> {
         rays: usize,
         rng: &mut R,
     ) -> ([f64; 3], u64) {
-        self.part_at(patch, points, rays, LightParts::All, rng)
+        let (b, _, rays) = self.part_at(patch, points, rays, LightParts::All, rng);
+        (b, rays)
     }
 
     /// [`Self::radiosity_at`]'s `parts` of the light: `All` is B = E + ρ·H; `Direct` is
     /// E + ρ·H_direct (the emitters and the sun by shadow rays, all `rays` theirs); `Indirect`
     /// is ρ·H_indirect (the hemisphere, the emitters' light left out). `Direct` and `Indirect`
-    /// add up to `All`'s B in expectation.
+    /// add up to `All`'s B in expectation. Returns the value, the variance of the scalar ρ·H
+    /// it gathered (of its mean; 0 where nothing was gathered) and the rays cast.
     pub fn part_at<R: Rng>(
-        &self,
-        patch: usize,
-        points: &[Vec3],
-        rays: usize,
-        parts: LightParts,
-        rng: &mut R,
-    ) -> ([f64; 3], u64) {
-        let (b, _, rays) = self.part_and_variance_at(patch, points, rays, parts, rng);
-        (b, rays)
-    }
-
-    /// [`Self::part_at`], with the variance of the scalar ρ·H it gathered (of its mean; 0
-    /// where nothing was gathered).
-    pub fn part_and_variance_at<R: Rng>(
         &self,
         patch: usize,
         points: &[Vec3],
