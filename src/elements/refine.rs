@@ -229,6 +229,8 @@ impl<I: Intersector> Refiner<'_, I> {
     }
 
     /// Whether `rule`'s threshold cuts `e`, with its contrast and how it is cut.
+    // Seven: the element, its patch's work, and the fields of `Rule::Adaptive` taken apart by
+    // the one `match` that calls this (a struct of them would be the enum variant again).
     #[allow(clippy::too_many_arguments)]
     fn decide(
         &self,

@@ -1,10 +1,10 @@
 //! The patch table (docs/design.md §5): one CSV row per patch, stable ids in mesh order,
 //! `id, cx, cy, cz, nx, ny, nz, area, rho_r, rho_g, rho_b, e_r, e_g, e_b, b_r, b_g, b_b`
-//! (B = radiosity in W/m²; irradiance = (B − E)/ρ), then (issue 14) `lux, df`: the
-//! illuminance in lux (179 lm/W × the luminance-weighted irradiance, over the channels with
-//! ρ > 0; empty where the material reflects nothing, so its irradiance is unknown from B) and
-//! the daylight factor in % (lux over the sky's unobstructed horizontal illuminance, sun
-//! included; empty without a sky).
+//! (B = radiosity in W/m²; irradiance = (B − E)/ρ), then the daylight columns (docs/design.md
+//! §9) `lux, df`: the illuminance in lux (179 lm/W × the luminance-weighted irradiance, over
+//! the channels with ρ > 0; empty where the material reflects nothing, so its irradiance is
+//! unknown from B) and the daylight factor in % (lux over the sky's unobstructed horizontal
+//! illuminance, sun included; empty without a sky).
 
 use crate::mesh::Mesh;
 use crate::scene::Material;
@@ -12,7 +12,7 @@ use std::io::{self, BufRead, Write};
 
 /// The header's first 17 columns, exactly as other tools script against them.
 pub const HEADER: &str = "id,cx,cy,cz,nx,ny,nz,area,rho_r,rho_g,rho_b,e_r,e_g,e_b,b_r,b_g,b_b";
-/// The columns added after them (issue 14).
+/// The daylight columns added after them (docs/design.md §9).
 pub const DAYLIGHT_COLUMNS: &str = "lux,df";
 
 /// Luminance weights of the RGB channels (Rec. 709), for illuminance from RGB irradiance.

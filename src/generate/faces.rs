@@ -30,6 +30,8 @@ impl Gen<'_> {
 
     /// An axis plane at `c` facing `sign` along `axis`: the rectangle `r` minus `holes`, plus
     /// the triangles `fills`. The cut that gives fewer patches wins (strips along u or v).
+    // Seven: the plane (axis, offset, facing) and its outline (rectangle, holes, fills) are
+    // what every caller names; the generator's call sites read as the building's plan.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn plane(
         &mut self,

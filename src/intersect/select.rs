@@ -1,4 +1,4 @@
-//! Which intersector a solve casts through, chosen once per scene (issue 4; Sec. 2).
+//! Which intersector a solve casts through, chosen once per scene (docs/design.md §4; Sec. 2).
 //!
 //! [`AnyIntersector`] is the enum at the edge: the pipeline matches the configured
 //! [`IntersectorKind`] once, builds only the structures the scene needs, and hands the solver

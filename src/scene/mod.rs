@@ -59,7 +59,7 @@ pub struct Material {
     pub ke: [f64; 3],
     /// Where [`Material::rho`] came from (shown by `radiosity info`).
     pub rho_source: RhoSource,
-    /// Glazing (issue 14): the share of light that goes straight through, unchanged in
+    /// Glazing (docs/design.md §9): the share of light that goes straight through, unchanged in
     /// direction (0 for opaque); for tinted glazing, the mean of
     /// [`Material::transmittance_rgb`]. A ray meeting a pane goes through with this
     /// probability (docs/design.md §9). ρ + transmittance ≤ 1; the rest is absorbed. Read from

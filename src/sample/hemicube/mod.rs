@@ -136,6 +136,8 @@ impl Hemicube {
     /// The steps: size and clear the buffers; draw the jittered sample points; per patch, into
     /// the frame (`to_frame`) and onto the faces (`Hemicube::draw_patch`); read the cells
     /// back (`Hemicube::read_back`).
+    // Eight: the shot (shooter, eye, frame, jitter) and the per-thread scratch (`buf`, `out`),
+    // kept apart so that rayon's `for_each_init` owns the scratch and the shot is per call.
     #[allow(clippy::too_many_arguments)]
     pub fn shoot<R: Rng>(
         &self,

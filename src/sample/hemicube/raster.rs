@@ -366,6 +366,8 @@ fn raster_centres(
 
 /// Jittered: per row band, the cells the polygon's extent over the band can touch, each tested
 /// at its own sample point against the polygon's edge functions. Returns the cells it tested.
+// Nine: the innermost rasteriser; the face's depth and id buffers and the sample points are
+// borrowed as separate slices (disjoint borrows of one face), as `raster_centres` takes them.
 #[allow(clippy::too_many_arguments)]
 fn raster_jittered(
     face: &Face,
