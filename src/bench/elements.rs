@@ -1,4 +1,4 @@
-//! `radiosity bench elements`: adaptive elements against uniform meshing (issue 15, item 1;
+//! `radiosity bench elements`: adaptive elements against uniform meshing (docs/design.md §11;
 //! README, "Adaptive elements").
 //!
 //! One patch solve; then, on it, a fine *reference* (every patch cut uniformly to half the

@@ -1,5 +1,5 @@
-//! Adaptive elements (issue 15; Cohen, Greenberg, Immel & Brock 1986, *An efficient radiosity
-//! approach for realistic image synthesis*, IEEE CG&A 6(3), Sec. 3 "substructuring"):
+//! Adaptive elements (docs/design.md §11; Cohen, Greenberg, Immel & Brock 1986, *An efficient
+//! radiosity approach for realistic image synthesis*, IEEE CG&A 6(3), Sec. 3 "substructuring"):
 //! patches shoot, elements receive.
 //!
 //! The solve runs on the patches. Afterwards each patch is cut into *elements* in its own

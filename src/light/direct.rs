@@ -1,7 +1,7 @@
 //! Direct light from the emitting patches: shadow rays from a point to points drawn on the
 //! emitters by power ([`super::emitters`]), each sample E_j·cosθ_i·cosθ_j/(π r²) divided by
 //! its density and counted at its MIS weight against the hemisphere rays (the balance
-//! heuristic, [`super::emitters::Emitters::weight`]).
+//! heuristic, `Emitters::weight`).
 
 use super::gather::{latin, stratified_var, Gathered, Split, Spot};
 use super::{scalar, Kernel, Origin, Rgb};

@@ -80,3 +80,45 @@ impl Emitters {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three emitters of power 1, 2 and 1: the CDF picks each for its share of [0, 1), and
+    /// passes on where in its stretch the number fell.
+    #[test]
+    fn the_cdf_picks_by_power() {
+        let em = Emitters {
+            patches: vec![3, 5, 8],
+            cdf: vec![1.0, 3.0, 4.0],
+            points: Vec::new(),
+            power: 4.0,
+        };
+        assert_eq!(em.pick(0.1).0, 0);
+        let (e, w, rest) = em.pick(0.5);
+        assert_eq!((e, w), (1, 2.0));
+        assert!((rest - 0.5).abs() < 1e-6);
+        assert_eq!(em.pick(0.9).0, 2);
+        assert_eq!(em.pick(1.0).0, 2);
+    }
+
+    /// The balance heuristic: a light sample's and a hemisphere ray's weights for one
+    /// direction add up to one.
+    #[test]
+    fn the_weights_of_a_path_add_up_to_one() {
+        let em = Emitters {
+            patches: vec![0],
+            cdf: vec![2.0],
+            points: Vec::new(),
+            power: 2.0,
+        };
+        let e = Rgb::splat(10.0);
+        let w = em.weight(e, 0.7, 0.4, 1.5, 8.0, 24.0);
+        assert!(w > 0.0 && w < 1.0, "{w}");
+        let p_l = 10.0 / 2.0 * 1.5 * 1.5 / 0.4;
+        let p_c = 0.7 / std::f64::consts::PI;
+        assert!((w - 8.0 * p_l / (8.0 * p_l + 24.0 * p_c)).abs() < 1e-12);
+        assert_eq!(em.weight(e, 0.0, 0.4, 1.5, 0.0, 1.0), 1.0);
+    }
+}

@@ -183,3 +183,41 @@ pub(super) fn latin<R: Rng>(n: usize, ordered: bool, rng: &mut R) -> Vec<(f32, f
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    /// Collapsed pairs: the variance of the mean from the differences within pairs, an odd
+    /// last sample counted as a pair's worth.
+    #[test]
+    fn stratified_variance_collapses_pairs() {
+        assert_eq!(stratified_var(&[3.0]), 0.0);
+        let v = stratified_var(&[1.0, 3.0, 2.0, 2.0]);
+        assert!((v - 4.0 / 16.0).abs() < 1e-15, "{v}");
+        let odd = stratified_var(&[1.0, 3.0, 5.0]);
+        assert!((odd - 4.0 * 1.5 / 9.0).abs() < 1e-15, "{odd}");
+    }
+
+    /// Latin-hypercube points: one per stratum in each coordinate, the first in index order
+    /// when asked.
+    #[test]
+    fn latin_points_fill_every_stratum() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let n = 16;
+        for ordered in [false, true] {
+            let pts = latin(n, ordered, &mut rng);
+            let cell = |x: f32| ((x * n as f32) as usize).min(n - 1);
+            let mut us: Vec<usize> = pts.iter().map(|p| cell(p.0)).collect();
+            let mut vs: Vec<usize> = pts.iter().map(|p| cell(p.1)).collect();
+            if ordered {
+                assert_eq!(us, (0..n).collect::<Vec<_>>());
+            }
+            us.sort_unstable();
+            vs.sort_unstable();
+            assert_eq!(us, (0..n).collect::<Vec<_>>());
+            assert_eq!(vs, (0..n).collect::<Vec<_>>());
+        }
+    }
+}

@@ -1,5 +1,5 @@
 //! Hemisphere rays: cosine-weighted directions (the stratified polar grid of the paper's
-//! Sec. 2, turned by a random angle) cast through glazing ([`Kernel::cast`]), each returning
+//! Sec. 2, turned by a random angle) cast through glazing (`Kernel::cast`), each returning
 //! what the side it meets reflects towards it — the solution's B − E from afar, the light at
 //! the point it met when nearer than that side's size (the near-hit rule, [`NEAR`]) — plus an
 //! emitter's E at the hemisphere ray's MIS weight.

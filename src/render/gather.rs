@@ -27,12 +27,12 @@
 //! paired in random order), which is less noisy than s² independent gathers of the same rays.
 //!
 //! **Indirect cache** (`--indirect-spacing`): the indirect part of the light is gathered at
-//! the nodes of an [`IndirectCache`], every few pixels, and interpolated between them over one
+//! the nodes of an `IndirectCache`, every few pixels, and interpolated between them over one
 //! surface; the direct part stays per sample.
 //!
 //! **Deterministic for a seed**: a pixel's random numbers come from (seed,
-//! [`Stream::Picture`], pixel index) alone; rows are shaded in parallel, each into its own slice, so the image does
-//! not depend on the thread count or the scheduling.
+//! [`Stream::Picture`], pixel index) alone; rows are shaded in parallel, each into its own
+//! slice, so the image does not depend on the thread count or the scheduling.
 //!
 //! The image is the same linear radiosity (W/m² per channel) as the Gouraud path's, so
 //! exposure, tone mapping and the image writers treat the two alike.

@@ -66,8 +66,8 @@ pub fn run_render_with(job: &RenderJob, progress: &Progress) -> Result<OutputRep
 }
 
 /// The sky a saved solution was solved under, rebuilt from the settings it keeps
-/// (`settings.solve.sky`, issue 14); `Err` says why it cannot be (a file from a version whose
-/// sky settings this one does not read).
+/// (`settings.solve.sky`, docs/design.md §9); `Err` says why it cannot be (a file from a
+/// version whose sky settings this one does not read).
 pub fn saved_sky(sol: &SavedSolution) -> Result<Option<Sky>, String> {
     let spec = match sol.meta.settings.get("solve").and_then(|s| s.get("sky")) {
         None | Some(serde_json::Value::Null) => return Ok(None),

@@ -371,3 +371,23 @@ pub(crate) fn rng_for(seed: u64, stream: Stream, chunk: u64) -> rand_pcg::Pcg64M
     use rand::SeedableRng;
     rand_pcg::Pcg64Mcg::seed_from_u64(mix(mix(mix(seed) ^ stream.id()) ^ chunk))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::Stream;
+
+    /// The streams' numbers are part of every result (they seed the random numbers): they
+    /// must never change.
+    #[test]
+    fn the_streams_keep_their_numbers() {
+        assert_eq!(Stream::Shot(7).id(), 7);
+        assert_eq!(Stream::Gather.id(), u64::MAX - 1);
+        assert_eq!(Stream::Regather(0).id(), Stream::Gather.id());
+        assert_eq!(Stream::Regather(2).id(), u64::MAX - 1 - 2 * (1 << 32));
+        assert_eq!(Stream::Sky.id(), u64::MAX - 2);
+        assert_eq!(Stream::SkyPilot.id(), u64::MAX - 3);
+        assert_eq!(Stream::Sensors.id(), u64::MAX - 3);
+        assert_eq!(Stream::Picture.id(), u64::MAX - 4);
+        assert_eq!(Stream::Elements.id(), u64::MAX - 5);
+    }
+}

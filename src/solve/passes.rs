@@ -1,4 +1,4 @@
-//! An error target (`solve --error E`, issue 13 item 4): keep refining until the solver's own
+//! An error target (`solve --error E`, docs/design.md §8): keep refining until the solver's own
 //! estimate of the average weighted percent error (Sec. 3's metric, [`super::estimate`]) is at or
 //! below E, or a budget (`--max-time`, `--max-rays`, Ctrl-C) stops it.
 //!

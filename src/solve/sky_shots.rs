@@ -1,4 +1,5 @@
-//! Daylight (issue 14): the sky, the ground glow and the sun shoot first, as distant emitters.
+//! Daylight (docs/design.md §9): the sky, the ground glow and the sun shoot first, as distant
+//! emitters.
 //!
 //! In the paper's spirit every emitter shoots rays in proportion to its unshot energy, each ray
 //! carrying the same energy C (Sec. 2). A distant emitter is a piece of the sky (a Tregenza
