@@ -13,7 +13,11 @@
 //! - [`sample`] holds the paper's samplers: the adaptive polar hemisphere and the uniform and
 //!   non-uniform hemi-cubes (Sec. 2);
 //! - [`solve`] shoots (or gathers) energy: the driver, ray shots, hemi-cube shots, the hybrid's
-//!   switch (Sec. 4), the stopping rule (Sec. 3) and the energy books.
+//!   switch (Sec. 4), the stopping rule (Sec. 3) and the energy books;
+//! - [`light`] is the light at a point: emitters sampled by power, direct light and the sun
+//!   with their MIS weights, hemisphere rays with the near-hit rule, and the point query
+//!   ([`light::LightAt`]) the final gather, the pictures, the elements and the sensors share
+//!   (it reads the solution's types from [`solve`], whose final gather calls it).
 //!
 //! Around it: [`settings`] (the settings types and their one error), [`pipeline`] (what
 //! `radiosity solve` and `info` do), [`saved`] (commands on a saved solution: render, export,
@@ -32,6 +36,7 @@ pub mod export;
 pub mod generate;
 pub mod grid;
 pub mod intersect;
+pub mod light;
 pub mod mesh;
 pub mod model;
 pub mod pipeline;

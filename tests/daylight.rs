@@ -290,7 +290,7 @@ fn grey_glazing_with_a_colour_solves_bit_for_bit_as_without() {
 #[test]
 fn sensors_and_the_gathered_picture_see_the_tint() {
     use radiosity::intersect::embree::EmbreeScene;
-    use radiosity::solve::final_gather::{sensor_irradiance, PointGather};
+    use radiosity::light::LightAt;
     let spec = sky(SkyKind::Uniform, None);
     let skyl = radiosity::sky::Sky::new(&spec).unwrap();
     let rgb = tinted_glass().transmittance_rgb.unwrap();
@@ -303,20 +303,12 @@ fn sensors_and_the_gathered_picture_see_the_tint() {
         let s = roofed_with(glass);
         let (m, sol) = solve(&s, spec);
         let isect = EmbreeScene::build(&m, |_| true).unwrap();
-        let e = sensor_irradiance(
-            &m,
-            &s.materials,
-            &isect,
-            &sol.b,
-            Some(&skyl),
-            &sensors,
-            4096,
-            7,
-        );
+        let e = LightAt::new(&m, &s.materials, &isect, &sol.b, Some(&skyl), None)
+            .sensor_irradiance(&sensors, 4096, 7);
         let mean = [0, 1, 2].map(|q| e.iter().map(|v| v[q]).sum::<f64>() / e.len() as f64);
         h.push(mean);
         if s.materials.len() > 1 {
-            let g = PointGather::new(&m, &s.materials, &isect, &sol.b, Some(&skyl), None);
+            let g = LightAt::new(&m, &s.materials, &isect, &sol.b, Some(&skyl), None);
             let seen = g.view(vec3(2.0, 10.0, 2.0), vec3(0.0, -1.0, 0.0));
             assert!(seen.hit.is_some());
             let off = (0..3).map(|q| (seen.through[q] - rgb[q]).abs());

@@ -6,9 +6,9 @@ mod common;
 use radiosity::elements::{self, ElementSettings, Elements};
 use radiosity::export::solution::SavedSolution;
 use radiosity::intersect::embree::EmbreeScene;
+use radiosity::light::LightAt;
 use radiosity::mesh::Mesh;
 use radiosity::scene::Scene;
-use radiosity::solve::final_gather::PointGather;
 use radiosity::solve::{self, SolveSettings};
 use std::path::Path;
 
@@ -22,7 +22,7 @@ fn refined(
     let isect = EmbreeScene::build(m, |_| true).unwrap();
     let sol = solve::solve(m, &s.materials, &isect, &SolveSettings::default(), |_| {}).unwrap();
     let run = || {
-        let gather = PointGather::new(m, &s.materials, &isect, &sol.b, None, None);
+        let gather = LightAt::new(m, &s.materials, &isect, &sol.b, None, None);
         elements::refine(m, &gather, &sol.b, settings, 7)
     };
     let (el, st) = common::on_threads(threads, run);
@@ -135,7 +135,7 @@ fn ctrl_c_keeps_what_is_refined() {
     let (s, m) = common::project_scene("spot.obj");
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let sol = solve::solve(&m, &s.materials, &isect, &SolveSettings::default(), |_| {}).unwrap();
-    let gather = PointGather::new(&m, &s.materials, &isect, &sol.b, None, None);
+    let gather = LightAt::new(&m, &s.materials, &isect, &sol.b, None, None);
     let stop = std::sync::atomic::AtomicBool::new(true);
     let settings = ElementSettings::default();
     let ctrl_c = elements::Stop {

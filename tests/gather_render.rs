@@ -6,13 +6,13 @@ mod common;
 use common::*;
 use glam::{vec3, Vec3};
 use radiosity::intersect::embree::EmbreeScene;
+use radiosity::light::LightAt;
 use radiosity::mesh::Mesh;
 use radiosity::progress::Counter;
 use radiosity::render::{
     render_gather, render_linear, Camera, LinearImage, RenderOptions, Shading, ShadingSettings,
 };
 use radiosity::scene::Scene;
-use radiosity::solve::final_gather::PointGather;
 use radiosity::solve::{MethodKind, SolveSettings};
 use std::path::Path;
 
@@ -44,7 +44,7 @@ fn gathered(
     s: &ShadingSettings,
 ) -> LinearImage {
     let isect = EmbreeScene::build(m, |_| true).unwrap();
-    let g = PointGather::new(m, &scene.materials, &isect, b, None, None);
+    let g = LightAt::new(m, &scene.materials, &isect, b, None, None);
     render_gather(&g, cam, o, s, &Counter::hidden()).0
 }
 

@@ -1,4 +1,4 @@
-//! `radiosity bench elements`: adaptive elements against uniform meshing (issue 15, item 1;
+//! `radiosity bench elements`: adaptive elements against uniform meshing (docs/design.md §11;
 //! README, "Adaptive elements").
 //!
 //! One patch solve; then, on it, a fine *reference* (every patch cut uniformly to half the
@@ -16,8 +16,8 @@
 
 use crate::elements::{self, Elements, Rule, Test};
 use crate::intersect::select::IntersectorKind;
+use crate::light::LightAt;
 use crate::model::Model;
-use crate::solve::final_gather::PointGather;
 use crate::solve::{scalar, SolveSettings};
 use crate::Error;
 use serde::Serialize;
@@ -147,7 +147,7 @@ pub fn run(
     let (isect, _) = model.intersector(IntersectorKind::Auto)?;
     let sol = model.solve(Some(&isect), &job.solve, &Default::default(), |_| {})?;
     let m = &model.mesh;
-    let gather = PointGather::new(m, &model.scene.materials, &isect, &sol.b, None, None);
+    let gather = LightAt::new(m, &model.scene.materials, &isect, &sol.b, None, None);
     let min_size = elements::ElementSettings {
         min_size: job.min_size,
         ..Default::default()

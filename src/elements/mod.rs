@@ -1,5 +1,5 @@
-//! Adaptive elements (issue 15; Cohen, Greenberg, Immel & Brock 1986, *An efficient radiosity
-//! approach for realistic image synthesis*, IEEE CG&A 6(3), Sec. 3 "substructuring"):
+//! Adaptive elements (docs/design.md §11; Cohen, Greenberg, Immel & Brock 1986, *An efficient
+//! radiosity approach for realistic image synthesis*, IEEE CG&A 6(3), Sec. 3 "substructuring"):
 //! patches shoot, elements receive.
 //!
 //! The solve runs on the patches. Afterwards each patch is cut into *elements* in its own
@@ -8,7 +8,7 @@
 //! radiosity at its corners differs by more than a threshold — shadow boundaries, corners,
 //! beside lights — down to a minimum size ([`refine`](mod@refine)). The corners' radiosity is gathered at
 //! the corner itself, with the patch solution as the cache of the indirect light
-//! ([`crate::solve::final_gather::PointGather`], in place of Cohen 1986's vertex hemi-cubes).
+//! ([`crate::light::LightAt`], in place of Cohen 1986's vertex hemi-cubes).
 //! Unshot energy stays on the patches: the elements move no energy, and the energy books are
 //! the patches'. The elements are what is shown and exported ([`display`]): Gouraud shading on
 //! the elements' vertex radiosities is exactly Cohen 1986's display. So the light is smooth
@@ -26,8 +26,8 @@ pub mod geometry;
 pub mod refine;
 
 use crate::intersect::Intersector;
+use crate::light::LightAt;
 use crate::mesh::Mesh;
-use crate::solve::final_gather::PointGather;
 use crate::solve::scalar;
 use geometry::Elem;
 use glam::DVec2;
@@ -283,7 +283,7 @@ pub fn mean_radiosity(mesh: &Mesh, b: &[[f64; 3]]) -> f64 {
 /// from `seed`.
 pub fn refine<I: Intersector>(
     mesh: &Mesh,
-    gather: &PointGather<'_, I>,
+    gather: &LightAt<'_, I>,
     b: &[[f64; 3]],
     settings: &ElementSettings,
     seed: u64,
@@ -294,7 +294,7 @@ pub fn refine<I: Intersector>(
 /// [`refine()`], stopping early (keeping what is refined) on Ctrl-C or at a deadline.
 pub fn refine_until<I: Intersector>(
     mesh: &Mesh,
-    gather: &PointGather<'_, I>,
+    gather: &LightAt<'_, I>,
     b: &[[f64; 3]],
     settings: &ElementSettings,
     seed: u64,
@@ -318,7 +318,7 @@ pub fn refine_until<I: Intersector>(
 /// corner and at most `cap` elements, stopping early as `stop` says.
 pub fn refine_by<I: Intersector>(
     mesh: &Mesh,
-    gather: &PointGather<'_, I>,
+    gather: &LightAt<'_, I>,
     rule: Rule,
     rays: usize,
     cap: usize,

@@ -4,14 +4,14 @@
 //!
 //! **Values at the corners.** Cohen 1986 computes the radiosity at element vertices by
 //! hemi-cubes placed there, with the patches as the light's sources; here a gather takes the
-//! hemi-cube's place ([`PointGather::radiosity_at`]): direct light from every emitter (and the
+//! hemi-cube's place ([`LightAt::radiosity_at`]): direct light from every emitter (and the
 //! sun, the sky) sampled with shadow rays at the point, indirect light from the solved patch
 //! radiosities (the patch solution is the cache). A corner on a patch's boundary is gathered
 //! at a point moved [`INSET`] of the way towards the patch's centre, so that a corner in a
 //! room's edge does not cast its rays from inside the wall beside it.
 //!
 //! **Common random numbers.** Every corner of one scene polygon is gathered with a generator
-//! seeded alike, from (seed, [`ELEMENT_STREAM`], polygon): neighbouring corners then use the
+//! seeded alike, from (seed, [`Stream::Elements`], polygon): neighbouring corners then use the
 //! same directions and light samples, so the difference between two corners — what the
 //! refinement tests — is the light's, not the noise's.
 //!
@@ -21,16 +21,12 @@
 
 use super::geometry::{Cut, Elem, Root};
 use crate::intersect::Intersector;
+use crate::light::LightAt;
 use crate::mesh::Mesh;
-use crate::solve::final_gather::PointGather;
-use crate::solve::{rng_for, scalar};
+use crate::solve::{rng_for, scalar, Stream};
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::collections::HashMap;
-
-/// The "shot number" the element gathers draw their random numbers under (never a real
-/// shot's, nor another gather's).
-pub const ELEMENT_STREAM: u64 = u64::MAX - 5;
 
 /// A corner on a patch's boundary is gathered this fraction of the way towards the patch's
 /// centre.
@@ -89,7 +85,7 @@ pub(super) struct PatchWork {
 /// Everything the per-patch work reads.
 pub(super) struct Refiner<'a, I> {
     pub mesh: &'a Mesh,
-    pub gather: &'a PointGather<'a, I>,
+    pub gather: &'a LightAt<'a, I>,
     pub seed: u64,
     pub rays: usize,
     pub quantum: f64,
@@ -141,12 +137,14 @@ impl<I: Intersector> Refiner<'_, I> {
         let c = self.mesh.patches[patch].centre.as_dvec3();
         let at = p + (c - p) * INSET;
         let polygon = self.mesh.patches[patch].polygon as u64;
-        let mut rng = rng_for(self.seed, ELEMENT_STREAM, polygon);
+        let mut rng = rng_for(self.seed, Stream::Elements, polygon);
         let (b, rays) = self
             .gather
             .radiosity_at(patch, &[at.as_vec3()], self.rays, &mut rng);
         w.rays += rays;
-        let b = b.map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
+        let b = b
+            .to_array()
+            .map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
         w.cache.insert(k, b);
         b
     }

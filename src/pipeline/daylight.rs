@@ -3,10 +3,10 @@
 
 use crate::grid::{self, GridSpec, GridStats};
 use crate::intersect::Intersector;
+use crate::light::LightAt;
 use crate::mesh::Mesh;
 use crate::scene::Material;
 use crate::sky::{Frame, Sky, SkyKind, SkySpec, EFFICACY};
-use crate::solve::final_gather;
 use serde::Serialize;
 
 /// Rays each sensor gathers by default (`--grid-rays`): about 1 % noise per sensor.
@@ -76,7 +76,7 @@ pub struct GridResult {
 }
 
 /// Lux at each sensor of `spec` from the solution `b`: the gather at each point
-/// ([`final_gather::sensor_irradiance`]), luminance-weighted, × 179 lm/W; the daylight factor
+/// ([`LightAt::sensor_irradiance`]), luminance-weighted, × 179 lm/W; the daylight factor
 /// over `df_base` (0 without a sky).
 #[allow(clippy::too_many_arguments)]
 pub fn measure<I: Intersector>(
@@ -92,7 +92,7 @@ pub fn measure<I: Intersector>(
 ) -> Result<GridResult, grid::GridError> {
     let sensors = spec.sensors(mesh, isect, frame)?;
     let at: Vec<_> = sensors.iter().map(|s| (s.position, s.normal)).collect();
-    let h = final_gather::sensor_irradiance(mesh, materials, isect, b, sky, &at, rays, seed);
+    let h = LightAt::new(mesh, materials, isect, b, sky, None).sensor_irradiance(&at, rays, seed);
     let luma = crate::export::patches::LUMA;
     let lux: Vec<f64> = h
         .iter()

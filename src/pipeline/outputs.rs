@@ -123,14 +123,8 @@ pub fn write(
     let (elements, element_stats) = match isect {
         Some(isect) if refine && !stop.interrupted() && !stop.out_of_time() => {
             run.progress.phase("refining elements");
-            let gather = crate::solve::final_gather::PointGather::new(
-                m,
-                &scene.materials,
-                isect,
-                &sol.b,
-                sky.as_ref(),
-                None,
-            );
+            let gather =
+                crate::light::LightAt::new(m, &scene.materials, isect, &sol.b, sky.as_ref(), None);
             let (el, st) = elements::refine_until(
                 m,
                 &gather,
@@ -495,14 +489,8 @@ fn gather_picture(
     cam: &Camera,
 ) -> Result<(render::LinearImage, render::gather::GatherStats), Error> {
     let m = &run.model.mesh;
-    let gather = crate::solve::final_gather::PointGather::new(
-        m,
-        &run.model.scene.materials,
-        isect,
-        &run.sol.b,
-        sky,
-        None,
-    );
+    let gather =
+        crate::light::LightAt::new(m, &run.model.scene.materials, isect, &run.sol.b, sky, None);
     let shading = ShadingSettings {
         seed: job.settings.solve.seed,
         ..job.shading

@@ -1,4 +1,4 @@
-//! The final-gather renderer (issue 15, `--shading gather`): each pixel's visible points
+//! The final-gather renderer (`--shading gather`, docs/design.md §10): each pixel's visible points
 //! gather their light with rays, the radiosity solution serving as the cache of the indirect
 //! light — the two-pass "radiosity as a cache" pictures of Reichert (*A Two-Pass Radiosity
 //! Method Driven by Lights and Viewer Position*, MSc thesis, Cornell 1992) and Lischinski,
@@ -13,11 +13,11 @@
 //! - **Visible point**: a ray through the pixel (the backs of one-sided patches passed through,
 //!   as the rasterizer culls them; glazing seen and seen through).
 //! - **Direct light** from each emitter and the sun, sampled explicitly with shadow rays *at
-//!   that point* ([`PointGather::radiosity_at`], the solver's own light sampling and MIS): shadows
+//!   that point* ([`LightAt::radiosity_at`], the solver's own light sampling and MIS): shadows
 //!   as sharp as the geometry makes them, whatever the patch size.
 //! - **Indirect light**: cosine-weighted rays that take the solved B − E of the side they meet,
 //!   or follow it on when it is nearer than that side's size (the near-hit rule of the
-//!   solver's gather, `final_gather::NEAR`), so corners are not blotchy.
+//!   solver's gather, [`crate::light::NEAR`]), so corners are not blotchy.
 //! - B = E + ρ·H per channel, in f64; an emitter seen shows its emission. Rays that leave the
 //!   model see the sky (as an exitance π·L, the unit of B) when the solve had one, else black.
 //!
@@ -26,9 +26,13 @@
 //! stratified gather of s²·`--pixel-rays` rays (points, light samples and hemisphere cells
 //! paired in random order), which is less noisy than s² independent gathers of the same rays.
 //!
-//! **Deterministic for a seed**: a pixel's random numbers come from (seed, [`RENDER_STREAM`],
-//! pixel index) alone; rows are shaded in parallel, each into its own slice, so the image does
-//! not depend on the thread count or the scheduling.
+//! **Indirect cache** (`--indirect-spacing`): the indirect part of the light is gathered at
+//! the nodes of an `IndirectCache`, every few pixels, and interpolated between them over one
+//! surface; the direct part stays per sample.
+//!
+//! **Deterministic for a seed**: a pixel's random numbers come from (seed,
+//! [`Stream::Picture`], pixel index) alone; rows are shaded in parallel, each into its own
+//! slice, so the image does not depend on the thread count or the scheduling.
 //!
 //! The image is the same linear radiosity (W/m² per channel) as the Gouraud path's, so
 //! exposure, tone mapping and the image writers treat the two alike.
@@ -36,19 +40,16 @@
 use super::{Camera, LinearImage, RenderOptions};
 use crate::elements::refine::INSET;
 use crate::intersect::Intersector;
+use crate::light::{self, LightAt, LightParts, Rgb};
 use crate::mesh::Mesh;
 use crate::progress::Counter;
 use crate::settings::Invalid;
-use crate::solve::final_gather::{LightParts, PointGather};
-use crate::solve::{rng_for, scalar};
+use crate::solve::{rng_for, Stream};
 use glam::Vec3;
 use rand::Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
-
-/// The random-number stream of the pictures' pixels (never a shot's, nor a gather's).
-pub const RENDER_STREAM: u64 = u64::MAX - 4;
 
 /// Rays gathered per anti-aliasing sample by default (`--pixel-rays`): with the default 3×3
 /// samples, 144 per pixel (README, "Final-gather pictures", for the measurements behind it).
@@ -164,22 +165,15 @@ fn primary_ray(camera: &Camera, x: f32, y: f32, width: f32, height: f32) -> Opti
     (org.is_finite() && dir.is_finite() && dir != Vec3::ZERO).then_some((org, dir))
 }
 
-/// `sum` += `w`·`v`, per channel (`w` per channel too: tinted glazing's transmittance).
-fn add(sum: &mut [f64; 3], v: [f64; 3], w: [f64; 3]) {
-    for ((s, v), w) in sum.iter_mut().zip(v).zip(w) {
-        *s += w * v;
-    }
-}
-
 /// The samples of one pixel that met one side: its points and their weight per channel (the
 /// glazing's transmittance before them, summed).
 struct Group {
     patch: usize,
     points: Vec<Vec3>,
-    weight: [f64; 3],
+    weight: Rgb,
     /// The points whose indirect light no nodes interpolate, and their weight.
     alone: Vec<Vec3>,
-    alone_weight: [f64; 3],
+    alone_weight: Rgb,
 }
 
 /// Where the light of a point seen on `patch` is gathered: moved [`INSET`] of the way towards
@@ -198,32 +192,32 @@ struct Node {
     material: u32,
     normal: Vec3,
     point: Vec3,
-    value: [f64; 3],
+    value: Rgb,
 }
 
-/// The nodes: the indirect light at every `spacing`-th pixel corner, in rows of `cols`.
-struct Nodes {
+/// The picture's indirect cache: the indirect light at every `spacing`-th pixel corner (its
+/// nodes, in rows of `cols`), interpolated between them over one surface.
+struct IndirectCache {
     spacing: f32,
     cols: usize,
     rows: usize,
     at: Vec<Option<Node>>,
 }
 
-impl Nodes {
+impl IndirectCache {
     /// Gathers the nodes of a `width`×`height` picture, `rays` hemisphere rays each; returns
     /// them and the rays cast.
     fn gather<I: Intersector>(
-        gather: &PointGather<I>,
+        light: &LightAt<I>,
         camera: &Camera,
         (width, height): (usize, usize),
         spacing: usize,
         rays: usize,
         seed: u64,
-    ) -> (Nodes, u64) {
+    ) -> (IndirectCache, u64) {
         let cols = width.div_ceil(spacing) + 1;
         let rows = height.div_ceil(spacing) + 1;
-        let (fw, fh) = (width as f32, height as f32);
-        let mesh = gather.mesh();
+        let size = (width as f32, height as f32);
         let per_row: Vec<(Vec<Option<Node>>, u64)> = (0..rows)
             .into_par_iter()
             .map(|j| {
@@ -231,42 +225,8 @@ impl Nodes {
                 let row = (0..cols)
                     .map(|i| {
                         let index = (j * cols + i) as u64;
-                        // A stream of its own: pixel indices stay far below 2^63.
-                        let mut rng = rng_for(seed, RENDER_STREAM, (1 << 63) | index);
-                        let (x, y) = ((i * spacing) as f32, (j * spacing) as f32);
-                        let (org, dir) = primary_ray(camera, x, y, fw, fh)?;
-                        let seen = gather.view(org, dir);
-                        cast += seen.rays;
-                        let h = seen.hit?;
-                        let x = inset(mesh, h.patch, h.point);
-                        let (mut value, var, n) =
-                            gather.part_at(h.patch, &[x], rays, LightParts::Indirect, &mut rng);
-                        cast += n;
-                        // A noisy node (daylight through a window: a bright patch of sky
-                        // few hemisphere rays find) gathers more, pooled by rays.
-                        let rel = var.sqrt() / scalar(&value).max(f64::MIN_POSITIVE);
-                        let more = ((rel / NODE_ERROR).powi(2) - 1.0).min(NODE_MORE as f64 - 1.0);
-                        let extra = (more * rays as f64).round() as usize;
-                        if extra >= 2 {
-                            let (v, _, n) = gather.part_at(
-                                h.patch,
-                                &[x],
-                                extra,
-                                LightParts::Indirect,
-                                &mut rng,
-                            );
-                            cast += n;
-                            let w = extra as f64 / (rays + extra) as f64;
-                            value = [0, 1, 2].map(|q| value[q] * (1.0 - w) + v[q] * w);
-                        }
-                        let p = &mesh.patches[h.patch];
-                        Some(Node {
-                            polygon: p.polygon,
-                            material: p.material,
-                            normal: p.normal,
-                            point: h.point,
-                            value,
-                        })
+                        let at = ((i * spacing) as f32, (j * spacing) as f32);
+                        Self::node(light, camera, at, size, rays, (seed, index), &mut cast)
                     })
                     .collect();
                 (row, cast)
@@ -275,7 +235,7 @@ impl Nodes {
         let cast = per_row.iter().map(|r| r.1).sum();
         let at = per_row.into_iter().flat_map(|r| r.0).collect();
         (
-            Nodes {
+            IndirectCache {
                 spacing: spacing as f32,
                 cols,
                 rows,
@@ -285,12 +245,57 @@ impl Nodes {
         )
     }
 
+    /// The node at image point `(x, y)` of a picture of `size` pixels: what the camera ray
+    /// there sees, and the indirect light gathered there with `rays` hemisphere rays (more
+    /// where that is noisy), drawn from (seed, [`Stream::Picture`], 2⁶³ + `index`); `None`
+    /// where the ray sees no side. Adds the rays cast to `cast`.
+    fn node<I: Intersector>(
+        light: &LightAt<I>,
+        camera: &Camera,
+        (x, y): (f32, f32),
+        (fw, fh): (f32, f32),
+        rays: usize,
+        (seed, index): (u64, u64),
+        cast: &mut u64,
+    ) -> Option<Node> {
+        let mesh = light.mesh();
+        // A stream of its own: pixel indices stay far below 2^63.
+        let mut rng = rng_for(seed, Stream::Picture, (1 << 63) | index);
+        let (org, dir) = primary_ray(camera, x, y, fw, fh)?;
+        let seen = light.view(org, dir);
+        *cast += seen.rays;
+        let h = seen.hit?;
+        let x = inset(mesh, h.patch, h.point);
+        let (mut value, var, n) =
+            light.part_at(h.patch, &[x], rays, LightParts::Indirect, &mut rng);
+        *cast += n;
+        // A noisy node (daylight through a window: a bright patch of sky few hemisphere rays
+        // find) gathers more, pooled by rays.
+        let rel = var.sqrt() / light::scalar(value).max(f64::MIN_POSITIVE);
+        let more = ((rel / NODE_ERROR).powi(2) - 1.0).min(NODE_MORE as f64 - 1.0);
+        let extra = (more * rays as f64).round() as usize;
+        if extra >= 2 {
+            let (v, _, n) = light.part_at(h.patch, &[x], extra, LightParts::Indirect, &mut rng);
+            *cast += n;
+            let w = extra as f64 / (rays + extra) as f64;
+            value = value * (1.0 - w) + v * w;
+        }
+        let p = &mesh.patches[h.patch];
+        Some(Node {
+            polygon: p.polygon,
+            material: p.material,
+            normal: p.normal,
+            point: h.point,
+            value,
+        })
+    }
+
     /// The indirect light at image point (x, y), the point `at` on `patch`, interpolated
     /// bilinearly from those of the four nodes around it that saw the sample's surface — the
     /// same material facing alike in the same plane (a polygon, or coplanar neighbours such
     /// as a ceiling's tiles) — their weights renormalised; `None` when none did (an object's
     /// edge seen against another): gathered there instead.
-    fn interpolate(&self, mesh: &Mesh, patch: usize, at: Vec3, x: f32, y: f32) -> Option<[f64; 3]> {
+    fn interpolate(&self, mesh: &Mesh, patch: usize, at: Vec3, x: f32, y: f32) -> Option<Rgb> {
         let (gx, gy) = (x / self.spacing, y / self.spacing);
         let (i, j) = (gx.floor() as usize, gy.floor() as usize);
         if i + 1 >= self.cols || j + 1 >= self.rows {
@@ -298,7 +303,7 @@ impl Nodes {
         }
         let (tx, ty) = (f64::from(gx - i as f32), f64::from(gy - j as f32));
         let p = &mesh.patches[patch];
-        let (mut v, mut total) = ([0.0; 3], 0.0);
+        let (mut v, mut total) = (Rgb::ZERO, 0.0);
         for (di, dj, w) in [
             (0, 0, (1.0 - tx) * (1.0 - ty)),
             (1, 0, tx * (1.0 - ty)),
@@ -319,20 +324,159 @@ impl Nodes {
             // Never a zero weight for a node that counts (a sample exactly on a node line).
             let w = w + 1e-9;
             total += w;
-            for (x, y) in v.iter_mut().zip(n.value) {
-                *x += w * y;
-            }
+            v += w * n.value;
         }
-        (total > 0.0).then(|| v.map(|x| x / total))
+        (total > 0.0).then(|| v / total)
     }
 }
 
-/// Renders the view of `camera` by a final gather per pixel through `gather` (see the module
+/// What every pixel of one picture is shaded with: the light, the camera, the indirect cache
+/// (with nodes), s×s samples per pixel and the rays of each.
+struct Shader<'s, I> {
+    light: &'s LightAt<'s, I>,
+    camera: &'s Camera,
+    cache: Option<&'s IndirectCache>,
+    /// The picture's size in pixels, s, and the aft plane's distance when there is one.
+    size: (f32, f32),
+    s: usize,
+    far: Option<f32>,
+    /// Rays per sample, and the half of them the direct light takes with nodes.
+    rays: usize,
+    half: usize,
+    seed: u64,
+}
+
+impl<I: Intersector> Shader<'_, I> {
+    /// Pixel (x, y) of a picture `width` pixels wide: its linear radiosity and the rays cast.
+    fn pixel(
+        &self,
+        (x, y): (usize, usize),
+        width: usize,
+        groups: &mut Vec<Group>,
+    ) -> ([f32; 3], u64) {
+        let index = (y * width + x) as u64;
+        let mut rng = rng_for(self.seed, Stream::Picture, index);
+        groups.clear();
+        let (mut sum, mut cast) = self.samples((x, y), groups, &mut rng);
+        cast += self.gather_groups(groups, &mut sum, &mut rng);
+        let s = self.s;
+        let px = sum.to_array().map(|v| {
+            let v = (v / (s * s) as f64) as f32;
+            if v.is_finite() {
+                v.max(0.0)
+            } else {
+                0.0
+            }
+        });
+        (px, cast)
+    }
+
+    /// The s×s jittered samples of pixel (x, y): what each sees (the panes, the sky, the
+    /// indirect light the cache interpolates) summed, the sides they met in `groups`; and the
+    /// rays cast.
+    fn samples<R: Rng>(
+        &self,
+        (x, y): (usize, usize),
+        groups: &mut Vec<Group>,
+        rng: &mut R,
+    ) -> (Rgb, u64) {
+        let (s, (fw, fh)) = (self.s, self.size);
+        let mesh = self.light.mesh();
+        let (mut sum, mut cast) = (Rgb::ZERO, 0u64);
+        for k in 0..s * s {
+            let (a, b) = ((k % s) as f32, (k / s) as f32);
+            let (ja, jb) = (rng.gen::<f32>(), rng.gen::<f32>());
+            let fx = x as f32 + (a + ja) / s as f32;
+            let fy = y as f32 + (b + jb) / s as f32;
+            let Some((org, dir)) = primary_ray(self.camera, fx, fy, fw, fh) else {
+                continue;
+            };
+            let seen = self.light.view(org, dir);
+            cast += seen.rays;
+            // Beyond the aft plane (`-va`) nothing is seen, the sky neither, as the Gouraud
+            // picture and rpict draw it.
+            let beyond = |f: f32| {
+                seen.hit
+                    .is_none_or(|h| self.camera.project(h.point).is_none_or(|(_, z)| z > f))
+            };
+            if self.far.is_some_and(beyond) {
+                continue;
+            }
+            sum += Rgb::ONE * seen.panes;
+            let Some(h) = seen.hit else {
+                sum += seen.through * self.light.sky_exitance(dir);
+                continue;
+            };
+            let at = match groups.iter().position(|g| g.patch == h.patch) {
+                Some(at) => at,
+                None => {
+                    groups.push(Group {
+                        patch: h.patch,
+                        points: Vec::new(),
+                        weight: Rgb::ZERO,
+                        alone: Vec::new(),
+                        alone_weight: Rgb::ZERO,
+                    });
+                    groups.len() - 1
+                }
+            };
+            let g = &mut groups[at];
+            let x = inset(mesh, h.patch, h.point);
+            g.points.push(x);
+            g.weight += seen.through;
+            let ind = self
+                .cache
+                .and_then(|c| c.interpolate(mesh, h.patch, h.point, fx, fy));
+            match ind {
+                Some(v) => sum += seen.through * v,
+                None => {
+                    g.alone.push(x);
+                    g.alone_weight += seen.through;
+                }
+            }
+        }
+        (sum, cast)
+    }
+
+    /// The light of the sides a pixel's samples met, gathered at their points and added to
+    /// `sum` by their weights: all of it without nodes; with nodes, the direct part, and the
+    /// indirect part of the points no nodes interpolate. Returns the rays cast.
+    fn gather_groups<R: Rng>(&self, groups: &[Group], sum: &mut Rgb, rng: &mut R) -> u64 {
+        let mut cast = 0;
+        for g in groups {
+            let n = g.points.len();
+            if self.cache.is_none() {
+                let (b, c) = self
+                    .light
+                    .radiosity_at(g.patch, &g.points, self.rays * n, rng);
+                cast += c;
+                *sum += g.weight * b;
+                continue;
+            }
+            let (b, _, c) =
+                self.light
+                    .part_at(g.patch, &g.points, self.half * n, LightParts::Direct, rng);
+            cast += c;
+            *sum += g.weight * b;
+            if !g.alone.is_empty() {
+                let rays = self.half * g.alone.len();
+                let (b, _, c) =
+                    self.light
+                        .part_at(g.patch, &g.alone, rays, LightParts::Indirect, rng);
+                cast += c;
+                *sum += g.alone_weight * b;
+            }
+        }
+        cast
+    }
+}
+
+/// Renders the view of `camera` by a final gather per pixel through `light` (see the module
 /// notes): `opts.supersample`² jittered samples per pixel, `settings.rays` rays gathered per
 /// sample, reproducible for `settings.seed`. `rows` moves on by one per finished row. A zero
 /// width or height gives an image without pixels.
 pub fn render_gather<I: Intersector>(
-    gather: &PointGather<I>,
+    light: &LightAt<I>,
     camera: &Camera,
     opts: &RenderOptions,
     settings: &ShadingSettings,
@@ -342,26 +486,23 @@ pub fn render_gather<I: Intersector>(
     let (width, height) = (opts.width as usize, opts.height as usize);
     let mut pixels = vec![[0.0f32; 3]; width.saturating_mul(height)];
     let mut stats = GatherStats::default();
+    let image = |pixels| LinearImage {
+        width: opts.width,
+        height: opts.height,
+        pixels,
+    };
     if pixels.is_empty() {
-        return (
-            LinearImage {
-                width: opts.width,
-                height: opts.height,
-                pixels,
-            },
-            stats,
-        );
+        return (image(pixels), stats);
     }
     let s = opts.supersample.clamp(1, 16) as usize;
-    let (fw, fh) = (opts.width as f32, opts.height as f32);
     let rays = settings.rays.clamp(1, MAX_PIXEL_RAYS);
     // With nodes, half a sample's rays go to the lights at the sample and the hemisphere's
     // half is gathered at the nodes, NODE_GAIN pixels' worth each.
     let spacing = settings.indirect_spacing.min(MAX_INDIRECT_SPACING);
     let half = (rays / 2).max(1);
-    let nodes = (spacing > 0).then(|| {
-        Nodes::gather(
-            gather,
+    let cache = (spacing > 0).then(|| {
+        IndirectCache::gather(
+            light,
             camera,
             (width, height),
             spacing,
@@ -369,8 +510,17 @@ pub fn render_gather<I: Intersector>(
             settings.seed,
         )
     });
-    let mesh = gather.mesh();
-    let far = camera.far_distance();
+    let shader = Shader {
+        light,
+        camera,
+        cache: cache.as_ref().map(|c| &c.0),
+        size: (opts.width as f32, opts.height as f32),
+        s,
+        far: camera.far_distance(),
+        rays,
+        half,
+        seed: settings.seed,
+    };
     let counts: Vec<u64> = pixels
         .par_chunks_mut(width)
         .enumerate()
@@ -378,125 +528,17 @@ pub fn render_gather<I: Intersector>(
             let mut groups: Vec<Group> = Vec::new();
             let mut cast = 0u64;
             for (x, px) in row.iter_mut().enumerate() {
-                let index = (y * width + x) as u64;
-                let mut rng = rng_for(settings.seed, RENDER_STREAM, index);
-                groups.clear();
-                let mut sum = [0.0f64; 3];
-                for k in 0..s * s {
-                    let (a, b) = ((k % s) as f32, (k / s) as f32);
-                    let (ja, jb) = (rng.gen::<f32>(), rng.gen::<f32>());
-                    let fx = x as f32 + (a + ja) / s as f32;
-                    let fy = y as f32 + (b + jb) / s as f32;
-                    let Some((org, dir)) = primary_ray(camera, fx, fy, fw, fh) else {
-                        continue;
-                    };
-                    let seen = gather.view(org, dir);
-                    cast += seen.rays;
-                    // Beyond the aft plane (`-va`) nothing is seen, the sky neither, as the
-                    // Gouraud picture and rpict draw it.
-                    let beyond = |f: f32| {
-                        seen.hit
-                            .is_none_or(|h| camera.project(h.point).is_none_or(|(_, z)| z > f))
-                    };
-                    if far.is_some_and(beyond) {
-                        continue;
-                    }
-                    add(&mut sum, seen.panes, [1.0; 3]);
-                    match seen.hit {
-                        Some(h) => {
-                            let at = match groups.iter().position(|g| g.patch == h.patch) {
-                                Some(at) => at,
-                                None => {
-                                    groups.push(Group {
-                                        patch: h.patch,
-                                        points: Vec::new(),
-                                        weight: [0.0; 3],
-                                        alone: Vec::new(),
-                                        alone_weight: [0.0; 3],
-                                    });
-                                    groups.len() - 1
-                                }
-                            };
-                            let g = &mut groups[at];
-                            let x = inset(mesh, h.patch, h.point);
-                            g.points.push(x);
-                            for q in 0..3 {
-                                g.weight[q] += seen.through[q];
-                            }
-                            let ind = nodes
-                                .as_ref()
-                                .and_then(|(n, _)| n.interpolate(mesh, h.patch, h.point, fx, fy));
-                            match ind {
-                                Some(v) => add(&mut sum, v, seen.through),
-                                None => {
-                                    g.alone.push(x);
-                                    for q in 0..3 {
-                                        g.alone_weight[q] += seen.through[q];
-                                    }
-                                }
-                            }
-                        }
-                        None => {
-                            add(&mut sum, gather.sky_exitance(dir), seen.through);
-                        }
-                    }
-                }
-                for g in &groups {
-                    if nodes.is_none() {
-                        let (b, n) = gather.radiosity_at(
-                            g.patch,
-                            &g.points,
-                            rays * g.points.len(),
-                            &mut rng,
-                        );
-                        cast += n;
-                        add(&mut sum, b, g.weight);
-                        continue;
-                    }
-                    let (b, _, n) = gather.part_at(
-                        g.patch,
-                        &g.points,
-                        half * g.points.len(),
-                        LightParts::Direct,
-                        &mut rng,
-                    );
-                    cast += n;
-                    add(&mut sum, b, g.weight);
-                    if !g.alone.is_empty() {
-                        let (b, _, n) = gather.part_at(
-                            g.patch,
-                            &g.alone,
-                            half * g.alone.len(),
-                            LightParts::Indirect,
-                            &mut rng,
-                        );
-                        cast += n;
-                        add(&mut sum, b, g.alone_weight);
-                    }
-                }
-                *px = sum.map(|v| {
-                    let v = (v / (s * s) as f64) as f32;
-                    if v.is_finite() {
-                        v.max(0.0)
-                    } else {
-                        0.0
-                    }
-                });
+                let (v, c) = shader.pixel((x, y), width, &mut groups);
+                *px = v;
+                cast += c;
             }
             rows.inc(1);
             cast
         })
         .collect();
     stats.samples = (width * height * s * s) as u64;
-    stats.rays = counts.iter().sum::<u64>() + nodes.as_ref().map_or(0, |n| n.1);
+    stats.rays = counts.iter().sum::<u64>() + cache.as_ref().map_or(0, |n| n.1);
     stats.rays_per_pixel = stats.rays as f64 / (width * height) as f64;
     stats.seconds = t0.elapsed().as_secs_f64();
-    (
-        LinearImage {
-            width: opts.width,
-            height: opts.height,
-            pixels,
-        },
-        stats,
-    )
+    (image(pixels), stats)
 }

@@ -15,9 +15,9 @@ use super::OutputReport;
 use crate::elements::{self, ElementSettings, ElementStats};
 use crate::export::solution::SavedSolution;
 use crate::intersect::select::{self, IntersectorKind};
+use crate::light::{LightAt, Relit};
 use crate::progress::Progress;
 use crate::render::Shading;
-use crate::solve::final_gather::{PointGather, Relit};
 use crate::solve::lights::{SKY_CHANNEL, SUN_CHANNEL};
 use crate::solve::scalar;
 use crate::Error;
@@ -123,7 +123,7 @@ pub fn refine_relit(
     let (isect, _) = select::select(&mesh, IntersectorKind::Auto)?;
     let materials: Vec<_> = out.meta.materials.iter().map(|m| m.material()).collect();
     let sky = saved_sky_or_warn(out, "the relit elements", warnings);
-    let gather = PointGather::new(
+    let gather = LightAt::new(
         &mesh,
         &materials,
         &isect,

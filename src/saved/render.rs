@@ -11,12 +11,12 @@ use crate::export::image::{self as image_out, ImageKind};
 use crate::export::solution::SavedSolution;
 use crate::export::write_atomic;
 use crate::intersect::select::{self, IntersectorKind};
+use crate::light::{LightAt, Relit};
 use crate::progress::Progress;
 use crate::render::false_colour;
 use crate::render::gather::{render_gather, GatherStats};
 use crate::render::{self, Camera, LinearImage, Shading, ShadingSettings, ViewSettings};
 use crate::sky::{Sky, SkySpec};
-use crate::solve::final_gather::{PointGather, Relit};
 use crate::Error;
 use std::path::PathBuf;
 
@@ -66,8 +66,8 @@ pub fn run_render_with(job: &RenderJob, progress: &Progress) -> Result<OutputRep
 }
 
 /// The sky a saved solution was solved under, rebuilt from the settings it keeps
-/// (`settings.solve.sky`, issue 14); `Err` says why it cannot be (a file from a version whose
-/// sky settings this one does not read).
+/// (`settings.solve.sky`, docs/design.md §9); `Err` says why it cannot be (a file from a
+/// version whose sky settings this one does not read).
 pub fn saved_sky(sol: &SavedSolution) -> Result<Option<Sky>, String> {
     let spec = match sol.meta.settings.get("solve").and_then(|s| s.get("sky")) {
         None | Some(serde_json::Value::Null) => return Ok(None),
@@ -106,7 +106,7 @@ pub(crate) fn gather_image(
     let (isect, _) = select::select(&mesh, IntersectorKind::Auto)?;
     let materials: Vec<_> = sol.meta.materials.iter().map(|m| m.material()).collect();
     let sky = saved_sky_or_warn(sol, "the gathered picture", warnings);
-    let gather = PointGather::new(&mesh, &materials, &isect, &sol.b, sky.as_ref(), relit);
+    let gather = LightAt::new(&mesh, &materials, &isect, &sol.b, sky.as_ref(), relit);
     let rows = progress.start_count("rendering", u64::from(job.view.image.height));
     let out = render_gather(&gather, cam, &job.view.image, &job.shading, &rows);
     progress.finish();

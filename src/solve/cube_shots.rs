@@ -21,7 +21,7 @@
 //! depend on the thread count.
 
 use super::books::State;
-use super::rng_for;
+use super::{rng_for, Stream};
 use crate::mesh::Mesh;
 use crate::sample::hemicube::{Hemicube, HemicubeBuffer, ShotWork};
 use crate::sample::Frame;
@@ -139,9 +139,9 @@ impl CubeShooter {
                 let t = Instant::now();
                 let p = &mesh.patches[shot.patch];
                 // Sec. 3: a random rotation about the normal per shot (Cohen & Greenberg).
-                let mut rng = rng_for(seed, shot.index, u64::MAX);
+                let mut rng = rng_for(seed, Stream::Shot(shot.index), u64::MAX);
                 let frame = Frame::new(p.normal, rng.gen::<f32>() * std::f32::consts::TAU);
-                let mut jitter_rng = rng_for(seed, shot.index, 0);
+                let mut jitter_rng = rng_for(seed, Stream::Shot(shot.index), 0);
                 out.work = BUFFER.with_borrow_mut(|buf| {
                     shot.cube.shoot(
                         mesh,

@@ -115,20 +115,18 @@ pub fn shoot_with<I: Intersector>(
         Some((g, rays))
     });
     if let Some(((isect, shooting), rays)) = gather {
-        let gathers = final_gather::apply(
+        let inputs = final_gather::GatherInputs {
             mesh,
             materials,
             isect,
-            cfg.seed,
+            seed: cfg.seed,
             rays,
-            hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
-            &shooting,
-            sky.as_ref(),
-            hooks.reference.as_deref().map(Vec::as_slice),
-            &mut sol,
-            None,
-            &mut on_trace,
-        );
+            group: hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
+            shooting: &shooting,
+            sky: sky.as_ref(),
+            reference: hooks.reference.as_deref().map(Vec::as_slice),
+        };
+        let gathers = final_gather::apply(&inputs, &mut sol, None, &mut on_trace);
         // An error target may add gather rounds to these (`passes`).
         if let Some(shot) = sol.shooting.as_mut() {
             shot.gathers = Some(gathers);

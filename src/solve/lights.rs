@@ -160,7 +160,7 @@ pub fn backs_meeting_surfaces<I: crate::intersect::Intersector>(
     }
     let step = lights.len().div_ceil(FACING_PATCHES);
     let grid = PolarGrid::for_samples(16.0);
-    let mut rng = super::rng_for(0, 0, 0);
+    let mut rng = super::rng_for(0, super::Stream::Shot(0), 0);
     let (mut met, mut cast) = (0usize, 0usize);
     for &i in lights.iter().step_by(step) {
         let p = &mesh.patches[i];

@@ -1,4 +1,4 @@
-//! An error target (`solve --error E`, issue 13 item 4): keep refining until the solver's own
+//! An error target (`solve --error E`, docs/design.md §8): keep refining until the solver's own
 //! estimate of the average weighted percent error (Sec. 3's metric, [`super::estimate`]) is at or
 //! below E, or a budget (`--max-time`, `--max-rays`, Ctrl-C) stops it.
 //!
@@ -236,20 +236,20 @@ fn gathered<I: Intersector>(
         energy_per_ray: pre.stats.energy_per_ray,
     };
     let mut sol = pre.clone();
-    let gathers = final_gather::apply(
+    let sky = cfg.sky.as_ref().and_then(|s| Sky::new(s).ok());
+    let inputs = final_gather::GatherInputs {
         mesh,
         materials,
         isect,
-        cfg.seed,
+        seed: cfg.seed,
         rays,
-        hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
-        &shooting,
-        cfg.sky.as_ref().and_then(|s| Sky::new(s).ok()).as_ref(),
-        hooks.reference.as_deref().map(Vec::as_slice),
-        &mut sol,
-        more.map(|(prior, extra)| final_gather::Regather { prior, extra }),
-        &mut |_| {},
-    );
+        group: hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
+        shooting: &shooting,
+        sky: sky.as_ref(),
+        reference: hooks.reference.as_deref().map(Vec::as_slice),
+    };
+    let more = more.map(|(prior, extra)| final_gather::Regather { prior, extra });
+    let gathers = final_gather::apply(&inputs, &mut sol, more, &mut |_| {});
     let m = estimate_of(&sol);
     let base = Base {
         pre,

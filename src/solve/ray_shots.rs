@@ -13,7 +13,7 @@
 //! it. [`super::driver`] groups shots into waves of about [`WAVE_RAYS`] rays.
 
 use super::books::State;
-use super::{rng_for, scalar};
+use super::{rng_for, scalar, Stream};
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::Mesh;
 use crate::sample::{polar::PolarGrid, Frame};
@@ -73,14 +73,14 @@ pub(super) struct RayShot {
 
 /// Draws points uniformly over the area of one convex patch: a fan triangle chosen by area,
 /// then a uniform point in it. Built once per chunk of rays, so no work per ray but the draw.
-pub(super) struct PatchPoints {
+pub(crate) struct PatchPoints {
     apex: Vec3,
     /// (b, c, cumulative area) of each fan triangle (apex, b, c).
     fan: Vec<(Vec3, Vec3, f32)>,
 }
 
 impl PatchPoints {
-    pub(super) fn new(mesh: &Mesh, i: usize) -> PatchPoints {
+    pub(crate) fn new(mesh: &Mesh, i: usize) -> PatchPoints {
         let ids = mesh.patch_indices(i);
         let v = |k: usize| mesh.vertices[ids[k] as usize];
         let apex = v(0);
@@ -97,7 +97,7 @@ impl PatchPoints {
     /// The point at (u, v) of the unit square, an area-preserving map onto the patch (u picks
     /// the fan triangle and its first barycentric coordinate), so stratified (u, v) give
     /// stratified points (the final gather's).
-    pub(super) fn at(&self, u: f32, v: f32) -> Vec3 {
+    pub(crate) fn at(&self, u: f32, v: f32) -> Vec3 {
         let total = self.fan[self.fan.len() - 1].2;
         let x = u.clamp(0.0, 1.0) * total;
         let k = self
@@ -142,8 +142,8 @@ pub(super) struct RayCaster<'a, I> {
     jitter: bool,
     /// Smallest offset of ray origins off their patch: a few ulps of the largest coordinate.
     eps_floor: f32,
-    /// Straight-through transmittance per patch (glazing, issue 14); empty when nothing
-    /// transmits.
+    /// Straight-through transmittance per patch (glazing, docs/design.md §9); empty when
+    /// nothing transmits.
     trans: Vec<f32>,
     /// The factor T_c / T per patch a ray going through it carries its energy on with
     /// (`Material::tint`); empty when no glazing is tinted.
@@ -234,9 +234,10 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         let i = shot.patch;
         let patch = &self.mesh.patches[i];
         // Sec. 3: a random rotation of the sampling pattern about the normal, per shot.
-        let angle = rng_for(self.seed, shot.index, u64::MAX).gen::<f32>() * std::f32::consts::TAU;
+        let angle = rng_for(self.seed, Stream::Shot(shot.index), u64::MAX).gen::<f32>()
+            * std::f32::consts::TAU;
         let frame = Frame::new(patch.normal, angle);
-        let mut rng = rng_for(self.seed, shot.index, chunk as u64);
+        let mut rng = rng_for(self.seed, Stream::Shot(shot.index), chunk as u64);
         let eps = (1e-4 * (patch.area as f32).sqrt()).max(self.eps_floor);
         let points = PatchPoints::new(self.mesh, i);
         let mut out = Hits {

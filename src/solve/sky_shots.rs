@@ -1,4 +1,5 @@
-//! Daylight (docs/design.md §9): the sky, the ground glow and the sun shoot first, as distant emitters.
+//! Daylight (docs/design.md §9): the sky, the ground glow and the sun shoot first, as distant
+//! emitters.
 //!
 //! In the paper's spirit every emitter shoots rays in proportion to its unshot energy, each ray
 //! carrying the same energy C (Sec. 2). A distant emitter is a piece of the sky (a Tregenza
@@ -26,7 +27,7 @@
 
 use super::books::State;
 use super::ray_shots::{carried, Hits, RayCaster, BACK, CHUNK, ESCAPED};
-use super::rng_for;
+use super::{rng_for, Stream};
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::sample::polar::PolarGrid;
@@ -37,9 +38,6 @@ use rayon::prelude::*;
 
 /// Pilot rays per piece to estimate the share of its flux the model receives.
 pub const PILOT_RAYS: usize = 256;
-
-/// The random-number stream of the sky's rays (never a patch shot's number).
-const SKY_STREAM: u64 = u64::MAX - 2;
 
 /// Chunks of rays cast and applied together (bounds the memory of hit codes).
 const BATCH_CHUNKS: usize = 64;
@@ -114,7 +112,7 @@ pub(super) fn received_flux<I: Intersector>(
         .par_iter()
         .enumerate()
         .map(|(k, piece)| {
-            let mut rng = rng_for(seed, SKY_STREAM - 1, k as u64);
+            let mut rng = rng_for(seed, Stream::SkyPilot, k as u64);
             let hits = (0..grid.len())
                 .filter(|&r| {
                     let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);
@@ -184,7 +182,7 @@ pub(super) fn shoot<I: Intersector>(
             let hits: Vec<Hits> = batch
                 .par_iter()
                 .map(|&ch| {
-                    let mut rng = rng_for(seed, SKY_STREAM, ((k as u64) << 32) | ch as u64);
+                    let mut rng = rng_for(seed, Stream::Sky, ((k as u64) << 32) | ch as u64);
                     let mut out = Hits::default();
                     for r in ch * CHUNK..(ch * CHUNK + CHUNK).min(x) {
                         let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);

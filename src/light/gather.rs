@@ -1,0 +1,223 @@
+//! The gather at a point: the irradiance H at some points of one surface (a patch's, one
+//! pixel's, one sensor's point) from light samples of the emitters ([`super::direct`]), of the
+//! sun ([`super::sun`]) and cosine-weighted hemisphere rays ([`super::hemisphere`]), the
+//! rays shared out between them and their estimates combined by multiple importance sampling
+//! (see the module notes of [`super`]); with the variance of its mean, from the strata.
+
+use super::{Kernel, Origin, Rgb};
+use crate::intersect::Intersector;
+use crate::sample::polar::PolarGrid;
+use glam::Vec3;
+use rand::seq::SliceRandom;
+use rand::Rng;
+
+/// Which parts of the light a gather samples (the final-gather renderer gathers the indirect
+/// light at a few points of the image and interpolates it: [`super::LightAt::part_at`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightParts {
+    /// Everything: the emitters and the sun by shadow rays, the rest over the hemisphere, the
+    /// emitters met by hemisphere rays weighed against the light samples (MIS).
+    All,
+    /// The shadow rays alone: the emitters (at their MIS weight) and the sun.
+    Direct,
+    /// The hemisphere rays alone: what they meet, emitters at the complement of the weight
+    /// `Direct` gives them. `Direct` + `Indirect` is `All` in expectation.
+    Indirect,
+}
+
+/// One gather: irradiance H (RGB), per light channel, the scalar variance of ρ·H's mean, and
+/// the rays it cast.
+#[derive(Clone, Debug)]
+pub(crate) struct Gathered {
+    pub h: Rgb,
+    pub ch: Vec<Rgb>,
+    pub var: f64,
+    pub rays: u64,
+}
+
+/// Where a gather is made: the points `at(u, v)` of the unit square's map (a patch's, or one
+/// sensor's point) facing `n`, rays leaving patch `patch`'s surface ([`super::NO_PATCH`] for a
+/// sensor in the air) `eps` off it; `rho` weighs the channels of the variance.
+pub(crate) struct Spot<'s> {
+    pub patch: usize,
+    pub at: &'s dyn Fn(f32, f32) -> Vec3,
+    pub n: Vec3,
+    pub eps: f32,
+    pub rho: Rgb,
+}
+
+impl Spot<'_> {
+    /// Where rays leave from the point (u, v).
+    pub(super) fn origin(&self, u: f32, v: f32) -> Origin {
+        Origin {
+            patch: self.patch,
+            x: (self.at)(u, v) + self.n * self.eps,
+            n: self.n,
+            eps: self.eps,
+        }
+    }
+}
+
+/// What a gather is asked for: `rays` in all (half to the emitters, a quarter to the sun when
+/// there is one, the rest over the hemisphere), which `parts` of the light; `lights` false
+/// sends the emitters' half over the hemisphere too: for points no emitter faces, which a
+/// hemisphere ray then cannot meet on its emitting side either.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Ask {
+    pub rays: usize,
+    pub lights: bool,
+    pub parts: LightParts,
+}
+
+/// How a gather's rays are shared out: light samples of the emitters and of the sun, the
+/// hemisphere's polar grid, and the counts the MIS weights use.
+pub(super) struct Split {
+    pub direct: usize,
+    pub sun: usize,
+    pub grid: PolarGrid,
+    pub nl: f64,
+    pub nc: f64,
+}
+
+impl Split {
+    /// `rays_wanted` rays for `parts`, with emitters to sample (`lamps`) and a `sun` or not.
+    fn new(parts: LightParts, lamps: bool, sun: bool, rays_wanted: usize) -> Split {
+        let (direct, n_sun) = match (parts, lamps, sun) {
+            (LightParts::Indirect, _, _) => (0, 0),
+            (LightParts::All, l, s) => (
+                if l { (rays_wanted / 2).max(1) } else { 0 },
+                if s { (rays_wanted / 4).max(1) } else { 0 },
+            ),
+            // All the rays to the lights: two thirds to the emitters when there is a sun too.
+            (LightParts::Direct, true, true) => {
+                let d = (rays_wanted * 2 / 3).max(1);
+                (d, rays_wanted.saturating_sub(d).max(1))
+            }
+            (LightParts::Direct, true, false) => (rays_wanted.max(1), 0),
+            (LightParts::Direct, false, true) => (0, rays_wanted.max(1)),
+            (LightParts::Direct, false, false) => (0, 0),
+        };
+        let grid = PolarGrid::for_samples(rays_wanted.saturating_sub(direct + n_sun).max(2) as f64);
+        // The MIS weights (balance heuristic, by the counts of light and hemisphere samples).
+        // Split in two parts gathered apart, both weigh as if by equal counts (the split of
+        // `All` without a sun), so that the two weights of a path still add up to one: the
+        // light samples of `Direct` and the hemisphere rays of `Indirect` share each
+        // emitter's light, neither taking it all (light samples alone are unbounded beside an
+        // emitter, at a room's corner).
+        let (nl, nc) = match parts {
+            LightParts::All => (direct as f64, grid.len() as f64),
+            LightParts::Direct | LightParts::Indirect => (if lamps { 1.0 } else { 0.0 }, 1.0),
+        };
+        Split {
+            direct,
+            sun: n_sun,
+            grid,
+            nl,
+            nc,
+        }
+    }
+}
+
+impl<I: Intersector> Kernel<'_, I> {
+    /// The gather at `spot` that `ask` asks for: the emitters' light samples, the sun's, then
+    /// the hemisphere rays, in that order (so the random numbers are drawn in that order).
+    pub(crate) fn gather_at<R: Rng>(&self, spot: &Spot, ask: Ask, rng: &mut R) -> Gathered {
+        let mut g = Gathered {
+            h: Rgb::ZERO,
+            ch: vec![Rgb::ZERO; self.sol.channels.len()],
+            var: 0.0,
+            rays: 0,
+        };
+        let lamps = !self.emitters.is_empty() && ask.lights;
+        let sun = self.sky.sun();
+        let split = Split::new(ask.parts, lamps, sun.is_some(), ask.rays);
+        if split.direct > 0 {
+            self.direct_part(spot, &split, &mut g, rng);
+        }
+        if let Some(sun) = sun.filter(|_| split.sun > 0) {
+            self.sun_part(spot, sun, split.sun, &mut g, rng);
+        }
+        if ask.parts != LightParts::Direct {
+            self.hemisphere_part(spot, &split, &mut g, rng);
+        }
+        g
+    }
+}
+
+/// The variance of the mean of stratified samples, by collapsing neighbouring strata in
+/// pairs (Cochran, *Sampling Techniques*, 3rd ed., 1977, Sec. 5A.12; Wolter, *Introduction to
+/// Variance Estimation*, 2nd ed., 2007, Sec. 8.2, the successive-difference estimator): samples
+/// `2m` and `2m + 1` come from neighbouring strata (adjacent polar cells of one ring; adjacent
+/// draws along the emitters' CDF), so Var(mean) ≈ Σ_m (x_2m − x_2m+1)² / N². The sample
+/// variance of independent draws would ignore what stratification removes and overstate the
+/// gather's noise several times over.
+pub(super) fn stratified_var(x: &[f64]) -> f64 {
+    let n = x.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let sum: f64 = x.chunks_exact(2).map(|p| (p[0] - p[1]).powi(2)).sum();
+    // An odd last sample counts as a pair's worth of the others.
+    let pairs = n / 2;
+    sum * (n as f64 / (2 * pairs) as f64) / (n * n) as f64
+}
+
+/// Latin-hypercube points on the unit square: both coordinates stratified into `n` strata,
+/// each coordinate's strata in an independent random order — or, with `ordered`, the first
+/// coordinate's strata in index order (sample k in stratum k, for the collapsed-pair variance).
+/// Two sets zipped together must not both be ordered: their first coordinates would be
+/// perfectly correlated (points on one part of the patch always paired with one light).
+pub(super) fn latin<R: Rng>(n: usize, ordered: bool, rng: &mut R) -> Vec<(f32, f32)> {
+    let mut pu: Vec<usize> = (0..n).collect();
+    let mut pv = pu.clone();
+    if !ordered {
+        pu.shuffle(rng);
+    }
+    pv.shuffle(rng);
+    pu.iter()
+        .zip(&pv)
+        .map(|(&a, &b)| {
+            let u = (a as f32 + rng.gen::<f32>()) / n as f32;
+            let v = (b as f32 + rng.gen::<f32>()) / n as f32;
+            (u.min(1.0), v.min(1.0))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    /// Collapsed pairs: the variance of the mean from the differences within pairs, an odd
+    /// last sample counted as a pair's worth.
+    #[test]
+    fn stratified_variance_collapses_pairs() {
+        assert_eq!(stratified_var(&[3.0]), 0.0);
+        let v = stratified_var(&[1.0, 3.0, 2.0, 2.0]);
+        assert!((v - 4.0 / 16.0).abs() < 1e-15, "{v}");
+        let odd = stratified_var(&[1.0, 3.0, 5.0]);
+        assert!((odd - 4.0 * 1.5 / 9.0).abs() < 1e-15, "{odd}");
+    }
+
+    /// Latin-hypercube points: one per stratum in each coordinate, the first in index order
+    /// when asked.
+    #[test]
+    fn latin_points_fill_every_stratum() {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(3);
+        let n = 16;
+        for ordered in [false, true] {
+            let pts = latin(n, ordered, &mut rng);
+            let cell = |x: f32| ((x * n as f32) as usize).min(n - 1);
+            let mut us: Vec<usize> = pts.iter().map(|p| cell(p.0)).collect();
+            let mut vs: Vec<usize> = pts.iter().map(|p| cell(p.1)).collect();
+            if ordered {
+                assert_eq!(us, (0..n).collect::<Vec<_>>());
+            }
+            us.sort_unstable();
+            vs.sort_unstable();
+            assert_eq!(us, (0..n).collect::<Vec<_>>());
+            assert_eq!(vs, (0..n).collect::<Vec<_>>());
+        }
+    }
+}

@@ -1,0 +1,297 @@
+//! Hemisphere rays: cosine-weighted directions (the stratified polar grid of the paper's
+//! Sec. 2, turned by a random angle) cast through glazing (`Kernel::cast`), each returning
+//! what the side it meets reflects towards it — the solution's B − E from afar, the light at
+//! the point it met when nearer than that side's size (the near-hit rule, [`NEAR`]) — plus an
+//! emitter's E at the hemisphere ray's MIS weight.
+
+use super::gather::{latin, stratified_var, Gathered, Split, Spot};
+use super::{add_to, scalar, Kernel, Origin, Rgb, NO_PATCH};
+use crate::intersect::{Hit, Intersector, Ray};
+use crate::sample::Frame;
+use glam::Vec3;
+use rand::Rng;
+
+/// A hemisphere ray meeting a side closer than this many times the side's size (√A) takes the
+/// light at the point it met, not the side's B (`Kernel::reflected_at`): a constant B over a
+/// patch is what the patch sends afar, not what its own parts send to something beside them.
+pub const NEAR: f32 = 1.0;
+
+/// Near hits followed one after another before the solution's B is taken as it is.
+pub const NEAR_DEPTH: u32 = 3;
+
+/// Surfaces a ray may step past (its own, glazing) before it is taken as lost.
+pub(super) const MAX_STEPS: usize = 16;
+
+/// What a ray met ([`Kernel::cast`]): the first opaque hit, the transmittance per channel of
+/// the glazing before it (the product of its panes' T_c), and what the panes' sides it met
+/// reflect towards it.
+pub(super) struct Traced {
+    pub hit: Option<Hit>,
+    pub through: Rgb,
+    pub panes: Rgb,
+}
+
+/// What a side reflects towards one hemisphere ray (RGB, per channel) and the rays it cost.
+#[derive(Default)]
+struct Reflected {
+    v: Rgb,
+    ch: Vec<Rgb>,
+    rays: u64,
+}
+
+impl<I: Intersector> Kernel<'_, I> {
+    /// The closest opaque hit along `ray`, stepping past patch `i`'s own surface (a ray leaving
+    /// a planar patch cannot meet it again; rounding may say otherwise).
+    ///
+    /// Glazing is seen and seen through: each pane met adds what its side reflects (B − E,
+    /// times the transmittance of the panes before it) and passes on its transmittance T_c
+    /// per channel (tinted glazing's colour: docs/design.md §9); the ray goes on to the first
+    /// opaque surface.
+    pub(super) fn cast(&self, i: usize, mut ray: Ray, eps: f32) -> Traced {
+        let own = (i != NO_PATCH).then(|| self.mesh.surface_of(i));
+        let mut out = Traced {
+            hit: None,
+            through: Rgb::ONE,
+            panes: Rgb::ZERO,
+        };
+        for _ in 0..MAX_STEPS {
+            match self.isect.intersect(&ray) {
+                Some(h) if Some(h.patch as usize) == own => ray.tnear = h.t + eps,
+                Some(h)
+                    if self
+                        .glazing
+                        .get(h.patch as usize)
+                        .is_some_and(|t| t.to_array().iter().any(|c| *c > 0.0)) =>
+                {
+                    if let Some(r) = self.mesh.receiver(h.patch, h.back) {
+                        out.panes += out.through * self.sol.reflected(r as usize);
+                    }
+                    out.through *= self.glazing[h.patch as usize];
+                    ray.tnear = h.t + (h.t * 1e-5).max(self.eps_floor);
+                }
+                other => {
+                    out.hit = other;
+                    return out;
+                }
+            }
+        }
+        // Lost among surfaces: nothing seen beyond.
+        out.through = Rgb::ZERO;
+        out
+    }
+
+    /// The side a ray's hit gives its light to, and how far it is.
+    fn receiver_of(&self, hit: Option<Hit>) -> Option<(usize, f32)> {
+        hit.and_then(|h| Some((self.mesh.receiver(h.patch, h.back)? as usize, h.t)))
+    }
+
+    /// What emitter `r`, met at distance `t` by a hemisphere ray along `dir` from a point
+    /// facing `n`, adds to it: its E on its emitting side, times the complement of the weight
+    /// its light samples have (none when there are none, `n_l` = 0).
+    fn emitted_towards(&self, r: usize, n: Vec3, dir: Vec3, t: f32, n_l: f64, n_c: f64) -> Rgb {
+        let e = self.sol.e[r];
+        let mut emitted = Rgb::ZERO;
+        if scalar(e) > 0.0 {
+            let cos_r = -f64::from(self.mesh.patches[r].normal.dot(dir));
+            if cos_r > 0.0 {
+                let w = if n_l > 0.0 {
+                    let cos_i = f64::from(n.dot(dir));
+                    self.emitters
+                        .weight(e, cos_i, cos_r, f64::from(t), n_l, n_c)
+                } else {
+                    0.0
+                };
+                emitted = e * (1.0 - w);
+            }
+        }
+        emitted
+    }
+
+    /// The hemisphere's part of a gather at `spot`: cosine-weighted rays through the polar
+    /// cells, each taking what the side it meets reflects (`reflected_at`) and, when there are
+    /// light samples too, its emission at the hemisphere ray's MIS weight (the light samples
+    /// count the rest of it); rays that leave see the sky. Into `g`.
+    pub(super) fn hemisphere_part<R: Rng>(
+        &self,
+        spot: &Spot,
+        split: &Split,
+        g: &mut Gathered,
+        rng: &mut R,
+    ) {
+        let x_count = split.grid.len();
+        let angle = rng.gen::<f32>() * std::f32::consts::TAU;
+        let frame = Frame::new(spot.n, angle);
+        let here = latin(x_count, false, rng);
+        let mut m = Vec::with_capacity(x_count);
+        let mut sum = Rgb::ZERO;
+        for (cell, &(u, v)) in here.iter().enumerate() {
+            let dir = frame.to_world(split.grid.direction(cell, 0.0, true, rng));
+            let org = spot.origin(u, v).x;
+            let ray = Ray {
+                org,
+                dir,
+                tnear: 0.0,
+                tfar: f32::INFINITY,
+            };
+            g.rays += 1;
+            let seen = self.cast(spot.patch, ray, spot.eps);
+            let recv = self.receiver_of(seen.hit);
+            let mut emitted = Rgb::ZERO;
+            let mut sub = Reflected::default();
+            if let Some((r, t)) = recv {
+                if split.nl > 0.0 {
+                    emitted = self.emitted_towards(r, spot.n, dir, t, split.nl, split.nc);
+                }
+                sub = self.reflected_at(r, org + dir * t, t, 0, rng);
+                g.rays += sub.rays;
+            }
+            if seen.hit.is_none() {
+                sub.v = self.sky.exitance(dir);
+            }
+            let val = seen.panes + seen.through * (sub.v + emitted);
+            m.push(scalar(spot.rho * val));
+            sum += val;
+            if let Some((r, _)) = recv {
+                for (c, chc) in g.ch.iter_mut().enumerate() {
+                    let lit = if self.sol.own(r, c) {
+                        emitted
+                    } else {
+                        Rgb::ZERO
+                    };
+                    *chc += seen.through * (sub.ch[c] + lit) / x_count as f64;
+                }
+            } else if seen.hit.is_none() {
+                let w = seen.through / x_count as f64;
+                add_to(&mut g.ch, self.sky.sky_channel, sub.v, w);
+            }
+        }
+        g.h += sum / x_count as f64;
+        g.var += stratified_var(&m);
+    }
+
+    /// The light side `r` reflects towards a hemisphere ray that met it at `y` from distance
+    /// `t` (RGB, and per channel). From afar, the solution's B_r − E_r. From nearer than r's
+    /// size (√A_r · [`NEAR`]), where a constant B over r is not what this point sees (the wall
+    /// behind a shelf 5 cm in front of it is dark, the 0.5 m wall patch is not), ρ_r times the
+    /// irradiance at `y` itself ([`Self::followed`]), at most [`NEAR_DEPTH`] times: a path
+    /// followed through the narrow gap until it leaves it (the close-hit rule of final
+    /// gathers, Jensen, *Realistic Image Synthesis Using Photon Mapping*, 2001, Sec. 9.4.2,
+    /// with the solution as the cache).
+    fn reflected_at<R: Rng>(
+        &self,
+        r: usize,
+        y: Vec3,
+        t: f32,
+        depth: u32,
+        rng: &mut R,
+    ) -> Reflected {
+        let area = self.mesh.patches[r].area as f32;
+        let near = t < NEAR * area.sqrt();
+        if depth >= NEAR_DEPTH || !near || scalar(self.sol.rho[r]) <= 0.0 {
+            return self.solved(r);
+        }
+        self.followed(r, y, depth, rng)
+    }
+
+    /// What the solution says side `r` reflects: B_r − E_r, and per channel the channel's B
+    /// less r's own emission where r's light is that channel's.
+    fn solved(&self, r: usize) -> Reflected {
+        let k = self.sol.channels.len();
+        Reflected {
+            v: self.sol.reflected(r),
+            ch: (0..k)
+                .map(|c| {
+                    let e = if self.sol.own(r, c) {
+                        self.sol.e[r]
+                    } else {
+                        Rgb::ZERO
+                    };
+                    (Rgb::from_array(self.sol.channels[c].b[r]) - e).max(Rgb::ZERO)
+                })
+                .collect(),
+            rays: 0,
+        }
+    }
+
+    /// ρ_r times the irradiance at `y` on side `r`, from one light sample, one cosine-weighted
+    /// ray (its hit taken by [`Self::reflected_at`] one level deeper) and one sun sample.
+    fn followed<R: Rng>(&self, r: usize, y: Vec3, depth: u32, rng: &mut R) -> Reflected {
+        let k = self.sol.channels.len();
+        let n = self.mesh.patches[r].normal;
+        let eps = self.eps_of(r);
+        let from = Origin {
+            patch: r,
+            x: y + n * eps,
+            n,
+            eps,
+        };
+        let x = from.x;
+        let mut acc = Reflected {
+            v: Rgb::ZERO,
+            ch: vec![Rgb::ZERO; k],
+            rays: 0,
+        };
+        let nl = if self.emitters.is_empty() { 0.0 } else { 1.0 };
+        // One light sample.
+        if nl > 0.0 {
+            let (e, w, _) = self.emitters.pick(rng.gen());
+            let yj = self.emitters.points[e].at(rng.gen(), rng.gen());
+            let (v, j, cast) = self.light_sample(&from, (e, w), yj, (1.0, 1.0));
+            if cast {
+                acc.rays += 1;
+                acc.v += v;
+                if let Some(c) = self.sol.group.and_then(|g| acc.ch.get_mut(g[j] as usize)) {
+                    *c += v;
+                }
+            }
+        }
+        // One cosine-weighted ray.
+        let (u1, u2) = (rng.gen::<f32>(), rng.gen::<f32>());
+        let (s, c) = (std::f32::consts::TAU * u2).sin_cos();
+        let rr = u1.sqrt();
+        let dir =
+            Frame::new(n, 0.0).to_world(Vec3::new(rr * c, rr * s, (1.0 - u1).max(0.0).sqrt()));
+        let ray = Ray {
+            org: x,
+            dir,
+            tnear: 0.0,
+            tfar: f32::INFINITY,
+        };
+        acc.rays += 1;
+        let seen = self.cast(r, ray, eps);
+        let (hit, w) = (seen.hit, seen.through);
+        let l = if hit.is_none() {
+            self.sky.exitance(dir)
+        } else {
+            Rgb::ZERO
+        };
+        acc.v += seen.panes + w * l;
+        add_to(&mut acc.ch, self.sky.sky_channel, l, w);
+        if let Some(sun) = self.sky.sun() {
+            acc.rays += 1;
+            let l = self.sun_sample(&from, sun, (rng.gen(), rng.gen()));
+            acc.v += l;
+            add_to(&mut acc.ch, self.sky.sun_channel, l, Rgb::ONE);
+        }
+        if let Some((s, t2)) = self.receiver_of(hit) {
+            let emitted = self.emitted_towards(s, n, dir, t2, nl, 1.0);
+            let sub = self.reflected_at(s, x + dir * t2, t2, depth + 1, rng);
+            acc.rays += sub.rays;
+            acc.v += w * (sub.v + emitted);
+            for (c, chc) in acc.ch.iter_mut().enumerate() {
+                let lit = if self.sol.own(s, c) {
+                    emitted
+                } else {
+                    Rgb::ZERO
+                };
+                *chc += w * (sub.ch[c] + lit);
+            }
+        }
+        let rho = self.sol.rho[r];
+        Reflected {
+            v: rho * acc.v,
+            ch: acc.ch.into_iter().map(|c| rho * c).collect(),
+            rays: acc.rays,
+        }
+    }
+}
