@@ -23,13 +23,15 @@
 //! `radiosity solve` and `info` do), [`saved`] (commands on a saved solution: render, export,
 //! relight), [`compare`] (reference and methods side by side), [`bench`](mod@bench) (benchmarks,
 //! cross-checks and the scene-size sweep), [`render`] (rasteriser, false colour, glyphs),
-//! [`export`] (file formats), [`report`] (summaries, traces, plots), [`generate`] (generated
+//! [`export`] (file formats), [`container`] (the binary container of the saved solution and
+//! the checkpoint), [`report`] (summaries, traces, plots), [`generate`] (generated
 //! buildings), [`grid`] (the sensor grid of a daylight study: placement, CSV, figures, plan).
 //! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
 pub mod bench;
 pub mod compare;
+pub mod container;
 pub mod elements;
 pub mod error;
 pub mod export;

@@ -7,7 +7,8 @@ mod common;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, Mesh, MeshOptions};
 use radiosity::scene::{self, LoadOptions, Scene};
-use radiosity::solve::checkpoint::{Sink, Snapshot};
+use radiosity::solve::checkpoint::Checkpoint;
+use radiosity::solve::driver::{Saved, Sink};
 use radiosity::solve::{self, MethodKind, RunHooks, Solution, SolveSettings, StopReason};
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -36,14 +37,13 @@ fn run_with(s: &Scene, m: &Mesh, cfg: &SolveSettings, hooks: &RunHooks) -> Solut
     solve::run(m, &s.materials, Some(&isect), cfg, hooks, |_| {}).unwrap()
 }
 
-/// Every safe point's snapshot, kept in memory.
-fn recording_sink() -> (Sink, Arc<Mutex<Vec<Snapshot>>>) {
+/// Every safe point's saved state, kept in memory.
+fn recording_sink() -> (Sink, Arc<Mutex<Vec<Saved>>>) {
     let kept = Arc::new(Mutex::new(Vec::new()));
     let k = kept.clone();
     let sink = Sink {
         every: Duration::ZERO,
-        key: "test".into(),
-        write: Arc::new(move |s: &Snapshot| {
+        write: Arc::new(move |s: &Saved| {
             k.lock().unwrap().push(s.clone());
             Ok(())
         }),
@@ -87,18 +87,16 @@ fn resumed_runs_equal_uninterrupted_ones() {
         );
         // Resume from a safe point in the middle, through the file format.
         let mid = &snaps[snaps.len() / 2];
-        let snap = Snapshot::from_bytes("mid", &mid.to_bytes()).unwrap();
-        assert!(snap.header.shots > 0);
-        assert_eq!(
-            snap.header.key, "test",
-            "the sink's key is in every snapshot"
-        );
+        let bytes = radiosity::solve::checkpoint::to_bytes("test", mid);
+        let snap = Checkpoint::from_bytes("mid", &bytes).unwrap();
+        assert!(snap.run.shots > 0);
+        assert_eq!(snap.key, "test", "the key is in the file");
         let resumed = run_with(
             &s,
             &m,
             &base,
             &RunHooks {
-                resume: Some(Arc::new(snap)),
+                resume: Some(Arc::new(snap.run)),
                 ..RunHooks::default()
             },
         );
@@ -125,8 +123,7 @@ fn an_interrupt_stops_at_a_safe_point_with_a_checkpoint() {
     let (k, f) = (kept.clone(), flag.clone());
     let sink = Sink {
         every: Duration::ZERO,
-        key: "test".into(),
-        write: Arc::new(move |snap: &Snapshot| {
+        write: Arc::new(move |snap: &Saved| {
             let mut v = k.lock().unwrap();
             v.push(snap.clone());
             // "Ctrl-C" after the third safe point.

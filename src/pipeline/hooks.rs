@@ -5,7 +5,8 @@
 use super::SolveJob;
 use crate::export::{patches, solution, write_atomic};
 use crate::model::Model;
-use crate::solve::checkpoint::{Sink, Snapshot};
+use crate::solve::checkpoint::{self, Checkpoint};
+use crate::solve::driver::{Saved, Sink};
 use crate::solve::{lights, RunHooks};
 use crate::Error;
 use std::sync::Arc;
@@ -19,7 +20,7 @@ pub fn build(job: &SolveJob, model: &Model, log: &mut impl FnMut(&str)) -> Resul
     };
     if let Some(by) = job.settings.per_light {
         let mut g = lights::groups(scene, m, by);
-        // The sky (with the ground glow) and the sun get channels of their own (issue 14).
+        // The sky (with the ground glow) and the sun get channels of their own.
         if let Some(spec) = &job.settings.solve.sky {
             g.names.push(lights::SKY_CHANNEL.to_string());
             if spec.sun.is_some() {
@@ -43,11 +44,11 @@ pub fn build(job: &SolveJob, model: &Model, log: &mut impl FnMut(&str)) -> Resul
     let key = job.settings.checkpoint_key(hash, m.patch_size);
     if let Some(path) = &job.checkpoint {
         let path = path.clone();
+        let key = key.clone();
         hooks.checkpoint = Some(Sink {
             every: std::time::Duration::from_secs_f64(job.checkpoint_every),
-            key: key.clone(),
-            write: Arc::new(move |snap: &Snapshot| {
-                let bytes = snap.to_bytes();
+            write: Arc::new(move |run: &Saved| {
+                let bytes = checkpoint::to_bytes(&key, run);
                 write_atomic(&path, |w| w.write_all(&bytes)).map_err(|e| e.to_string())
             }),
         });
@@ -56,13 +57,13 @@ pub fn build(job: &SolveJob, model: &Model, log: &mut impl FnMut(&str)) -> Resul
         let what = path.display().to_string();
         let bytes = std::fs::read(path)
             .map_err(|e| Error::Invalid(format!("--resume {what}: cannot read it ({e})")))?;
-        let snap = Snapshot::from_bytes(&what, &bytes).map_err(Error::Invalid)?;
-        snap.check_key(&what, &key).map_err(Error::Invalid)?;
+        let ckpt = Checkpoint::from_bytes(&what, &bytes).map_err(Error::Invalid)?;
+        ckpt.check_key(&what, &key).map_err(Error::Invalid)?;
         log(&format!(
             "resuming from {what}: {} shots, {:.1} s done",
-            snap.header.shots, snap.header.elapsed
+            ckpt.run.shots, ckpt.run.elapsed
         ));
-        hooks.resume = Some(Arc::new(snap));
+        hooks.resume = Some(Arc::new(ckpt.run));
     }
     Ok(hooks)
 }

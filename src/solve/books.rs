@@ -1,4 +1,4 @@
-//! The shooting solvers' books: per-patch unshot and gathered flux, the priority queues that
+//! The shooting solvers' books: per-patch unshot and kept flux, the priority queues that
 //! pick the next shooter, and the energy accounts. Shared by the ray shots
 //! ([`super::ray_shots`]) and the hemi-cube shots ([`super::cube_shots`]), so every method
 //! keeps the same books and stops by the same criterion (Sec. 3, [`super::stopping`]).
@@ -78,8 +78,8 @@ pub(super) fn add3(a: &mut [f64; 3], b: &[f64; 3]) {
 pub(super) struct PatchState {
     /// Unshot flux ΔΦ_j (W).
     pub unshot: [f64; 3],
-    /// Flux received and kept (ρ_j × what arrived), W: B_j = E_j + gathered/A_j.
-    pub gathered: [f64; 3],
+    /// Flux received and kept (ρ_j × what arrived), W: B_j = E_j + kept/A_j.
+    pub kept: [f64; 3],
     pub rho: [f32; 3],
     pub inv_area: f32,
 }
@@ -92,7 +92,7 @@ pub(super) struct PatchState {
 pub(super) struct Channels {
     pub k: usize,
     pub unshot: Vec<[f64; 3]>,
-    pub gathered: Vec<[f64; 3]>,
+    pub kept: Vec<[f64; 3]>,
 }
 
 /// The solver's mutable state: patches, heaps and energy accounts.
@@ -118,9 +118,35 @@ pub(super) struct State {
     rho_max: f64,
     /// Of each patch's kept flux, what hemi-cube shots left (scalar), and its sampling
     /// variance Σ ρ·e_cell·kept (see [`super::estimate`]). Empty until a hemi-cube shot lands.
-    cube_gathered: Vec<f64>,
+    cube_kept: Vec<f64>,
     cube_var: Vec<f64>,
     pub channels: Option<Channels>,
+}
+
+/// What a checkpoint keeps of the books ([`State::save`], [`State::restore`]): every
+/// patch's unshot and kept flux, the hemi-cube share of the kept flux and its variance, the
+/// per-light channels, and the energy accounts and counters. [`super::checkpoint`] lays it out
+/// in the file.
+#[derive(Clone, Debug, Default)]
+pub struct Saved {
+    pub energy: EnergyBalance,
+    /// Σ B_j·A_j, for the mean radiosity.
+    pub b_flux: [f64; 3],
+    pub rays: u64,
+    pub cells: u64,
+    pub shot_flux: f64,
+    /// Per patch (W, RGB).
+    pub unshot: Vec<[f64; 3]>,
+    pub kept: Vec<[f64; 3]>,
+    /// Per patch, what hemi-cube shots left of the kept flux (scalar) and its variance; empty
+    /// until a hemi-cube shot lands.
+    pub cube_kept: Vec<f64>,
+    pub cube_var: Vec<f64>,
+    /// Light channels per patch (0 without `--per-light`), and their unshot and kept flux,
+    /// `channels` per patch side by side.
+    pub channels: usize,
+    pub ch_unshot: Vec<[f64; 3]>,
+    pub ch_kept: Vec<[f64; 3]>,
 }
 
 impl State {
@@ -142,7 +168,7 @@ impl State {
                 let cap = if m.is_tinted() { f64::INFINITY } else { 1.0 };
                 PatchState {
                     unshot: m.emission().map(|x| x * p.area),
-                    gathered: [0.0; 3],
+                    kept: [0.0; 3],
                     rho: m.rho.map(|r| (r / land).min(cap) as f32),
                     inv_area: (1.0 / p.area) as f32,
                 }
@@ -163,7 +189,7 @@ impl State {
             shot_flux: 0.0,
             rho_mean: 0.0,
             rho_max: 0.0,
-            cube_gathered: Vec::new(),
+            cube_kept: Vec::new(),
             cube_var: Vec::new(),
             channels: None,
         };
@@ -254,7 +280,7 @@ impl State {
         let mut ch = Channels {
             k,
             unshot: vec![[0.0; 3]; n * k],
-            gathered: vec![[0.0; 3]; n * k],
+            kept: vec![[0.0; 3]; n * k],
         };
         for (j, &g) in group.iter().enumerate() {
             if (g as usize) < k {
@@ -295,13 +321,13 @@ impl State {
                         kept *= t[x];
                     }
                     ch.unshot[j * k + c][x] += kept;
-                    ch.gathered[j * k + c][x] += kept;
+                    ch.kept[j * k + c][x] += kept;
                 }
             }
         }
     }
 
-    /// Radiosity per channel and patch: B_j^c = E_j (if j is light c) + gathered_j^c / A_j.
+    /// Radiosity per channel and patch: B_j^c = E_j (if j is light c) + kept_j^c / A_j.
     pub fn channel_radiosity(
         &self,
         mesh: &Mesh,
@@ -322,7 +348,7 @@ impl State {
                         } else {
                             [0.0; 3]
                         };
-                        let g = ch.gathered[j * ch.k + c];
+                        let g = ch.kept[j * ch.k + c];
                         [0, 1, 2].map(|x| e[x] + g[x] / p.area)
                     })
                     .collect()
@@ -338,7 +364,7 @@ impl State {
         for (c, &phi) in phi.iter().enumerate() {
             let kept = p.rho[c] as f64 * phi;
             p.unshot[c] += kept;
-            p.gathered[c] += kept;
+            p.kept[c] += kept;
             self.b_flux[c] += kept;
             self.energy.absorbed[c] += phi - kept;
         }
@@ -352,13 +378,13 @@ impl State {
     /// average: also books the sampling variance it adds.
     #[inline]
     pub fn deposit_cube(&mut self, j: usize, phi: &[f64; 3], e_cell: f64) {
-        if self.cube_gathered.is_empty() {
-            self.cube_gathered = vec![0.0; self.patches.len()];
+        if self.cube_kept.is_empty() {
+            self.cube_kept = vec![0.0; self.patches.len()];
             self.cube_var = vec![0.0; self.patches.len()];
         }
         let rho = self.patches[j].rho.map(f64::from);
         let kept = scalar(&[0, 1, 2].map(|c| rho[c] * phi[c]));
-        self.cube_gathered[j] += kept;
+        self.cube_kept[j] += kept;
         self.cube_var[j] += scalar(&rho) * e_cell * kept;
         self.deposit(j, phi);
     }
@@ -436,14 +462,14 @@ impl State {
         });
     }
 
-    /// Radiosity per patch: B_j = E_j + gathered_j / A_j.
+    /// Radiosity per patch: B_j = E_j + kept_j / A_j.
     pub fn radiosity(&self, mesh: &Mesh, materials: &[Material]) -> Vec<[f64; 3]> {
         self.patches
             .iter()
             .zip(&mesh.patches)
             .map(|(s, p)| {
                 let e = materials[p.material as usize].emission();
-                [0, 1, 2].map(|c| e[c] + s.gathered[c] / p.area)
+                [0, 1, 2].map(|c| e[c] + s.kept[c] / p.area)
             })
             .collect()
     }
@@ -451,12 +477,12 @@ impl State {
     /// The error estimate's parts per patch from the books as they stand (no wave in flight):
     /// what the final gather weighs its own estimates against (`super::final_gather`).
     pub fn estimate_parts(&self, est: &Estimator) -> super::estimate::Parts {
-        let gathered: Vec<f64> = self.patches.iter().map(|p| scalar(&p.gathered)).collect();
+        let kept: Vec<f64> = self.patches.iter().map(|p| scalar(&p.kept)).collect();
         est.parts(&Books {
-            gathered: &gathered,
-            cube_gathered: &self.cube_gathered,
+            gathered: &kept,
+            cube_gathered: &self.cube_kept,
             cube_var: &self.cube_var,
-            kept: gathered.iter().sum(),
+            kept: kept.iter().sum(),
             unshot: self.patches.iter().map(|p| scalar(&p.unshot)).sum(),
             shot: self.shot_flux,
         })
@@ -471,69 +497,59 @@ impl State {
         self.energy.unshot = unshot;
     }
 
-    /// The books, for a checkpoint (the header's counters are filled by the caller).
-    pub fn snapshot(&self, header: super::checkpoint::Header) -> super::checkpoint::Snapshot {
-        let (ch_unshot, ch_gathered, k) = match &self.channels {
-            Some(c) => (c.unshot.clone(), c.gathered.clone(), c.k),
-            None => (Vec::new(), Vec::new(), 0),
+    /// What a checkpoint keeps of the books (assembled by [`super::checkpoint`]).
+    pub fn save(&self) -> Saved {
+        let (channels, ch_unshot, ch_kept) = match &self.channels {
+            Some(c) => (c.k, c.unshot.clone(), c.kept.clone()),
+            None => (0, Vec::new(), Vec::new()),
         };
-        super::checkpoint::Snapshot {
-            header: super::checkpoint::Header {
-                patches: self.patches.len(),
-                energy: self.energy,
-                b_flux: self.b_flux,
-                rays: self.rays,
-                cells: self.cells,
-                shot_flux: self.shot_flux,
-                cube_len: self.cube_gathered.len(),
-                channels: k,
-                ..header
-            },
+        Saved {
+            energy: self.energy,
+            b_flux: self.b_flux,
+            rays: self.rays,
+            cells: self.cells,
+            shot_flux: self.shot_flux,
             unshot: self.patches.iter().map(|p| p.unshot).collect(),
-            gathered: self.patches.iter().map(|p| p.gathered).collect(),
-            cube_gathered: self.cube_gathered.clone(),
+            kept: self.patches.iter().map(|p| p.kept).collect(),
+            cube_kept: self.cube_kept.clone(),
             cube_var: self.cube_var.clone(),
+            channels,
             ch_unshot,
-            ch_gathered,
+            ch_kept,
         }
     }
 
-    /// Puts a checkpoint's books back (onto a state built for the same mesh and settings) and
-    /// rebuilds the queues from them.
-    pub fn restore(&mut self, s: &super::checkpoint::Snapshot) -> Result<(), String> {
-        let h = &s.header;
+    /// Puts saved books back (onto a state built for the same mesh and settings) and rebuilds
+    /// the queues from them.
+    pub fn restore(&mut self, s: &Saved) -> Result<(), String> {
         let n = self.patches.len();
-        if h.patches != n || s.unshot.len() != n || s.gathered.len() != n {
+        if s.unshot.len() != n || s.kept.len() != n {
             return Err(format!(
                 "the checkpoint has {} patches, this mesh {n}",
-                h.patches
+                s.unshot.len()
             ));
         }
         let k = self.channels.as_ref().map_or(0, |c| c.k);
-        if h.channels != k {
+        if s.channels != k {
             return Err(format!(
                 "the checkpoint has {} light channels, this run {k} (--per-light must match)",
-                h.channels
+                s.channels
             ));
         }
-        for (p, (u, g)) in self
-            .patches
-            .iter_mut()
-            .zip(s.unshot.iter().zip(&s.gathered))
-        {
+        for (p, (u, g)) in self.patches.iter_mut().zip(s.unshot.iter().zip(&s.kept)) {
             p.unshot = *u;
-            p.gathered = *g;
+            p.kept = *g;
         }
-        self.energy = h.energy;
-        self.b_flux = h.b_flux;
-        self.rays = h.rays;
-        self.cells = h.cells;
-        self.shot_flux = h.shot_flux;
-        self.cube_gathered = s.cube_gathered.clone();
+        self.energy = s.energy;
+        self.b_flux = s.b_flux;
+        self.rays = s.rays;
+        self.cells = s.cells;
+        self.shot_flux = s.shot_flux;
+        self.cube_kept = s.cube_kept.clone();
         self.cube_var = s.cube_var.clone();
         if let Some(c) = &mut self.channels {
             c.unshot = s.ch_unshot.clone();
-            c.gathered = s.ch_gathered.clone();
+            c.kept = s.ch_kept.clone();
         }
         // The queues hold one current entry per patch with unshot light (the ones below the
         // max-ΔB heap's pruning threshold left out, as the running solve does).
@@ -570,18 +586,18 @@ impl State {
             .map(|p| scalar(&p.unshot) * p.inv_area as f64)
             .fold(max_b, f64::max);
         let unshot_flux: f64 = self.patches.iter().map(|p| scalar(&p.unshot)).sum();
-        let gathered: Vec<f64> = self.patches.iter().map(|p| scalar(&p.gathered)).collect();
+        let kept: Vec<f64> = self.patches.iter().map(|p| scalar(&p.kept)).collect();
         let estimate = est.metrics(&Books {
-            gathered: &gathered,
-            cube_gathered: &self.cube_gathered,
+            gathered: &kept,
+            cube_gathered: &self.cube_kept,
             cube_var: &self.cube_var,
-            kept: gathered.iter().sum(),
+            kept: kept.iter().sum(),
             // A wave cast but not applied yet is still light to come.
             unshot: unshot_flux + in_flight,
             shot: self.shot_flux - in_flight,
         });
         let error = reference.map(|r| {
-            let b: Vec<[f64; 3]> = gathered
+            let b: Vec<[f64; 3]> = kept
                 .iter()
                 .zip(est.emission)
                 .zip(est.area)

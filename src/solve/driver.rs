@@ -26,8 +26,7 @@
 //! and `max_time` (a clock budget, the one setting whose result depends on the clock), plus
 //! `--switch-by measured`.
 
-use super::books::State;
-use super::checkpoint::{Header, Snapshot, SYNC_WAVES};
+use super::books::{self, State};
 use super::cube_shots::{self, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WAVE};
 use super::estimate::Estimator;
 use super::final_gather;
@@ -39,14 +38,59 @@ use super::stopping::{self, Progress};
 use super::switch::{self, CostModel, SwitchPolicy};
 use super::{
     scalar, LightChannel, MethodKind, RunHooks, Solution, SolveError, SolveSettings, SolveStats,
-    StopReason, TracePoint,
+    StopReason, SwitchInfo, TracePoint,
 };
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
 use crate::sky::Sky;
 use rayon::prelude::*;
-use std::time::Instant;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Waves between safe points: one comes every this many waves whether or not anyone
+/// checkpoints, so runs with and without checkpoints, and resumed runs, shoot the same.
+pub const SYNC_WAVES: u64 = 8;
+
+/// What a checkpoint keeps of a shooting run at a safe point: the driver's counters and
+/// trace, and the states of the books and of the switch policy, each saved by its owner.
+/// [`super::checkpoint`] writes it to a file and reads it back; a run given one
+/// ([`RunHooks::resume`]) continues exactly as the run it was saved from.
+#[derive(Clone, Debug, Default)]
+pub struct Saved {
+    /// Seconds the run had taken.
+    pub elapsed: f64,
+    /// C, which the resumed run must share.
+    pub energy_per_ray: f64,
+    pub shots: u64,
+    pub waves: u64,
+    pub hemicube_shots: u64,
+    pub hemicube_cells: u64,
+    /// The hybrid's switch, once it has happened.
+    pub switched: Option<SwitchInfo>,
+    /// Hemi-cube shots still to come (the hemi-cube methods, or the hybrid before switching).
+    pub cubes_active: bool,
+    pub trace: Vec<TracePoint>,
+    pub books: books::Saved,
+    pub switch: switch::Saved,
+}
+
+/// Writes one saved state somewhere; an error is one line.
+pub type WriteFn = dyn Fn(&Saved) -> Result<(), String> + Send + Sync;
+
+/// Where checkpoints go (`--checkpoint`): a writer called with the run's state at the first
+/// safe point every `every`, and on interrupt (the pipeline writes the file atomically).
+#[derive(Clone)]
+pub struct Sink {
+    pub every: Duration,
+    pub write: Arc<WriteFn>,
+}
+
+impl std::fmt::Debug for Sink {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Sink {{ every: {:?} }}", self.every)
+    }
+}
 
 /// Shoots until Sec. 3's criterion or a budget stops it, by the method `cfg.method` names
 /// (any but gathering). `isect` is needed by the methods that cast rays (`adaptive-rays`,
@@ -76,8 +120,8 @@ pub fn shoot_with<I: Intersector>(
 ) -> Result<Solution, SolveError> {
     let start = Instant::now();
     let mut d = Driver::new(mesh, materials, isect, cfg, hooks, model)?;
-    if let Some(snap) = &hooks.resume {
-        d.resume(snap)?;
+    if let Some(saved) = &hooks.resume {
+        d.resume(saved)?;
     } else {
         d.shoot_sky();
     }
@@ -257,7 +301,7 @@ struct Driver<'a, I> {
     scalars: PatchScalars,
     /// Casts the rays (the methods that cast rays).
     caster: Option<RayCaster<'a, I>>,
-    /// The sky and sun (issue 14) and the sphere they shoot at.
+    /// The sky and sun and the sphere they shoot at.
     sky: Option<(Sky, sky_shots::Bounds)>,
     /// Hemi-cube shots still to come (the hemi-cube methods, or the hybrid before it switches).
     cubes: Option<CubeShooter>,
@@ -413,33 +457,50 @@ impl<'a, I: Intersector> Driver<'a, I> {
         }
     }
 
-    /// Carries on from a checkpoint: the books, the counters, the switch policy's state and
-    /// the trace so far (see [`super::checkpoint`]).
-    fn resume(&mut self, snap: &Snapshot) -> Result<(), SolveError> {
-        let h = &snap.header;
+    /// What a checkpoint keeps at a safe point (see [`Saved`]).
+    fn save(&self, elapsed: f64) -> Saved {
+        let stats = &self.stats;
+        Saved {
+            elapsed,
+            energy_per_ray: self.energy_per_ray,
+            shots: stats.shots,
+            waves: stats.waves,
+            hemicube_shots: stats.hemicube_shots,
+            hemicube_cells: stats.hemicube_cells,
+            switched: stats.switch,
+            cubes_active: self.cubes.is_some(),
+            trace: stats.trace.clone(),
+            books: self.st.save(),
+            switch: self.switch.save(),
+        }
+    }
+
+    /// Carries on from a saved state: the books, the counters, the switch policy's state and
+    /// the trace so far.
+    fn resume(&mut self, s: &Saved) -> Result<(), SolveError> {
         let c = self.energy_per_ray;
-        if (h.energy_per_ray - c).abs() > 1e-12 * c {
+        if (s.energy_per_ray - c).abs() > 1e-12 * c {
             return Err(SolveError::Checkpoint(format!(
                 "the checkpoint's energy per ray is {} W, this run's {c} W: resume with the same --tolerance or --energy-per-ray",
-                h.energy_per_ray
+                s.energy_per_ray
             )));
         }
-        self.st.restore(snap).map_err(SolveError::Checkpoint)?;
+        self.st.restore(&s.books).map_err(SolveError::Checkpoint)?;
         let stats = &mut self.stats;
-        stats.shots = h.shots;
-        stats.waves = h.waves;
-        stats.hemicube_shots = h.hemicube_shots;
-        stats.hemicube_cells = h.hemicube_cells;
-        stats.switch = h.switch;
-        stats.trace = h.trace.clone();
-        if !h.cubes_active {
+        stats.shots = s.shots;
+        stats.waves = s.waves;
+        stats.hemicube_shots = s.hemicube_shots;
+        stats.hemicube_cells = s.hemicube_cells;
+        stats.switch = s.switched;
+        stats.trace = s.trace.clone();
+        if !s.cubes_active {
             self.cubes = None;
         }
-        self.switch.restore(h);
-        self.time_offset = h.elapsed;
-        self.next_trace = h.elapsed;
-        self.next_trace_shots = h.shots;
-        self.next_checkpoint = h.elapsed;
+        self.switch.restore(&s.switch);
+        self.time_offset = s.elapsed;
+        self.next_trace = s.elapsed;
+        self.next_trace_shots = s.shots;
+        self.next_checkpoint = s.elapsed;
         Ok(())
     }
 
@@ -507,22 +568,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             .is_some_and(|f| f.load(std::sync::atomic::Ordering::Relaxed));
         if let Some(sink) = &self.hooks.checkpoint {
             if interrupted || elapsed >= self.next_checkpoint {
-                let stats = &self.stats;
-                let mut header = Header {
-                    key: sink.key.clone(),
-                    elapsed,
-                    shots: stats.shots,
-                    waves: stats.waves,
-                    hemicube_shots: stats.hemicube_shots,
-                    hemicube_cells: stats.hemicube_cells,
-                    energy_per_ray: self.energy_per_ray,
-                    switch: stats.switch,
-                    cubes_active: self.cubes.is_some(),
-                    trace: stats.trace.clone(),
-                    ..Header::default()
-                };
-                self.switch.save(&mut header);
-                (sink.write)(&self.st.snapshot(header)).map_err(SolveError::Checkpoint)?;
+                (sink.write)(&self.save(elapsed)).map_err(SolveError::Checkpoint)?;
                 self.next_checkpoint = elapsed + sink.every.as_secs_f64();
             }
         }
@@ -710,7 +756,6 @@ impl<'a, I: Intersector> Driver<'a, I> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::time::Duration;
 
     #[test]
     fn the_gather_fits_the_time_left_or_is_left_out() {

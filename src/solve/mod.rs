@@ -22,7 +22,8 @@
 //! - [`gathering`]: the traditional algorithm (full form-factor matrix, Gauss–Seidel);
 //! - [`final_gather`]: after shooting, the patches the shooting left noisy (the small ones)
 //!   gather their own light with rays, combined with the shooting's estimate by inverse variance;
-//! - [`checkpoint`], [`lights`] (per-light channels), [`settings`].
+//! - [`checkpoint`] (the file of a run's saved state: the driver's, the books' and the
+//!   switch's, each saved by its owner), [`lights`] (per-light channels), [`settings`].
 //!
 //! **Reproducible.** The same scene, mesh, settings and seed give bit-identical results on any
 //! run and any thread count, for every method: random numbers come from (seed, shot, chunk),
@@ -49,7 +50,38 @@ use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
 
-pub use settings::{MethodKind, RunHooks, SolveSettings, SwitchBy};
+pub use settings::{MethodKind, SolveSettings, SwitchBy};
+
+/// What a run plugs into the solver besides its settings: none of it changes the result
+/// (a checkpoint or an interrupt changes only where the run stops or resumes).
+#[derive(Clone, Default)]
+pub struct RunHooks {
+    /// Radiosity per patch of a reference solution (`--reference`): every trace point then
+    /// records the error against it.
+    pub reference: Option<std::sync::Arc<Vec<[f64; 3]>>>,
+    /// Keep one channel per light group (`--per-light`): the solution then carries each
+    /// light's own radiosity, for relighting without solving again.
+    pub light_groups: Option<std::sync::Arc<lights::LightGroups>>,
+    /// Write the run's state at the first safe point every so often, and on interrupt
+    /// (`--checkpoint`), through this sink.
+    pub checkpoint: Option<driver::Sink>,
+    /// Continue from this state (`--resume`, read by [`checkpoint::Checkpoint::from_bytes`]).
+    pub resume: Option<std::sync::Arc<driver::Saved>>,
+    /// Set (by a Ctrl-C handler) to stop at the next safe point.
+    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+}
+
+impl std::fmt::Debug for RunHooks {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunHooks")
+            .field("reference", &self.reference.as_ref().map(|r| r.len()))
+            .field("light_groups", &self.light_groups.as_ref().map(|g| g.len()))
+            .field("checkpoint", &self.checkpoint.is_some())
+            .field("resume", &self.resume.is_some())
+            .field("interrupt", &self.interrupt.is_some())
+            .finish()
+    }
+}
 
 /// Why the solve stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

@@ -1,6 +1,6 @@
 //! What a solve is asked to do ([`SolveSettings`]: plain, serialisable, checked once) and what
-//! the run around it plugs in ([`RunHooks`]: a reference to measure against, per-light
-//! channels, checkpoints, an interrupt flag).
+//! the run around it plugs in ([`super::RunHooks`]: a reference to measure against,
+//! per-light channels, checkpoints, an interrupt flag).
 //!
 //! The settings are the whole of what shapes a result: the same scene, mesh and settings give
 //! the same patch table on any run and any thread count. So everything that records "how was
@@ -10,7 +10,6 @@
 //!
 //! Defaults are constants, used by `Default` and by the command line's `default_value_t` alike.
 
-use super::{checkpoint, lights};
 use crate::settings::Invalid;
 use serde::{Deserialize, Serialize};
 
@@ -307,37 +306,6 @@ impl SolveSettings {
             ));
         }
         Ok(())
-    }
-}
-
-/// What a run plugs into the solver besides its settings: none of it changes the result
-/// (a checkpoint or an interrupt changes only where the run stops or resumes).
-#[derive(Clone, Default)]
-pub struct RunHooks {
-    /// Radiosity per patch of a reference solution (`--reference`): every trace point then
-    /// records the error against it.
-    pub reference: Option<std::sync::Arc<Vec<[f64; 3]>>>,
-    /// Keep one channel per light group (`--per-light`): the solution then carries each
-    /// light's own radiosity, for relighting without solving again.
-    pub light_groups: Option<std::sync::Arc<lights::LightGroups>>,
-    /// Write a checkpoint at the first safe point every so often, and on interrupt
-    /// (`--checkpoint`), through this sink.
-    pub checkpoint: Option<checkpoint::Sink>,
-    /// Continue from this checkpoint (`--resume`).
-    pub resume: Option<std::sync::Arc<checkpoint::Snapshot>>,
-    /// Set (by a Ctrl-C handler) to stop at the next safe point.
-    pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-}
-
-impl std::fmt::Debug for RunHooks {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RunHooks")
-            .field("reference", &self.reference.as_ref().map(|r| r.len()))
-            .field("light_groups", &self.light_groups.as_ref().map(|g| g.len()))
-            .field("checkpoint", &self.checkpoint.is_some())
-            .field("resume", &self.resume.is_some())
-            .field("interrupt", &self.interrupt.is_some())
-            .finish()
     }
 }
 

@@ -31,7 +31,6 @@
 //! ([`fit_cube`], [`fit_rays`]), and prints them beside the kept ones with the shot at which
 //! the hybrid switches under each.
 
-use super::checkpoint::Header;
 use super::cube_shots::CubeHits;
 use super::ray_shots::{tasks_of, RayCaster, RayShot, CHUNK};
 use super::{SolveSettings, SwitchBy, SwitchInfo};
@@ -138,8 +137,8 @@ impl CostModel {
 }
 
 /// Running totals of the hemi-cube shots' counted work so far, from which the next shot's
-/// work is predicted. Saved in checkpoints, so a resumed run predicts the same.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// work is predicted. Saved in checkpoints ([`Saved`]), so a resumed run predicts the same.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct WorkTally {
     pub shots: u64,
     pub faces: u64,
@@ -390,6 +389,19 @@ pub(super) fn probe<I: Intersector>(caster: &RayCaster<I>, patch: usize) -> f64 
     per_ray
 }
 
+/// What a checkpoint keeps of the switch policy ([`SwitchPolicy::save`]): what it has learnt
+/// so far, so a resumed run decides as the uninterrupted one. [`super::checkpoint`] lays it
+/// out in the file.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Saved {
+    /// `adaptive-hybrid`: the hemi-cube shots' counted work so far.
+    pub tally: WorkTally,
+    /// `--switch-by measured`: the sums of the fit of hemi-cube shot times
+    /// ([`CubeCost::sums`]), and the measured seconds per ray.
+    pub cube_cost: [f64; 5],
+    pub ray_cost: Option<f64>,
+}
+
 /// The hybrid's switch policy during one solve: what it has learnt so far (counted work, or
 /// measured times) and the rule it applies.
 pub(super) struct SwitchPolicy {
@@ -417,17 +429,19 @@ impl SwitchPolicy {
     }
 
     /// Carries on from a checkpoint.
-    pub fn restore(&mut self, h: &Header) {
-        self.tally = h.cube_work;
-        self.cube_cost = CubeCost::from_sums(h.cube_cost);
-        self.ray_cost = h.ray_cost;
+    pub fn restore(&mut self, s: &Saved) {
+        self.tally = s.tally;
+        self.cube_cost = CubeCost::from_sums(s.cube_cost);
+        self.ray_cost = s.ray_cost;
     }
 
     /// What a checkpoint keeps of it.
-    pub fn save(&self, h: &mut Header) {
-        h.cube_work = self.tally;
-        h.cube_cost = self.cube_cost.sums();
-        h.ray_cost = self.ray_cost;
+    pub fn save(&self) -> Saved {
+        Saved {
+            tally: self.tally,
+            cube_cost: self.cube_cost.sums(),
+            ray_cost: self.ray_cost,
+        }
     }
 
     /// Books a hemi-cube shot of `cells` cells that did `hits.work` in `hits.seconds`.
