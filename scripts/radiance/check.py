@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Check a radiosity solve against Radiance on the same model, patch by patch.
 
-1. ``radiosity solve MODEL --out DIR/solve --save DIR/solve/solution.rad [--solve-args]``, then
-   ``radiosity export`` to a PLY (one face per patch, in patch order) for the patch polygons;
+1. ``radiosity solve MODEL --out DIR/solve --save DIR/solve/solution.rad --elements off
+   [--solve-args]``, then ``radiosity export`` to a PLY (one face per patch, in patch order: the
+   export draws the elements when there are any) for the patch polygons;
    the tool's irradiance per patch is (B - E) / rho from ``patches.csv``.
 2. The same OBJ/MTL written as a Radiance scene (``objrad.py``: ``plastic`` with the tool's rho,
    ``light`` with radiance Ke), ``oconv``, and ``rtrace -I`` at stratified points inside each
@@ -52,14 +53,19 @@ def solve(binary: Path, model: Path, out: Path, solve_args: list[str]):
     sdir = out / "solve"
     sdir.mkdir(parents=True, exist_ok=True)
     sol = sdir / "solution.rad"
+    # The patch polygons come from the export, which draws the adaptive elements when the
+    # solution has them: without elements it is one face per patch (patches.csv is the same
+    # either way; the elements never feed back into the patches).
+    no_elements = [] if any(a.startswith("--elements") for a in solve_args) else ["--elements", "off"]
     t0 = time.perf_counter()
-    run([binary, "solve", model, "--out", sdir, "--save", sol, "--quiet", *solve_args])
+    run([binary, "solve", model, "--out", sdir, "--save", sol, "--quiet", *no_elements, *solve_args])
     wall = time.perf_counter() - t0
     run([binary, "export", sol, "--out", sdir / "patches.ply", "--quiet"])
     table = read_patches(sdir / "patches.csv")
     polys = read_ply_faces(sdir / "patches.ply")
     if len(polys) != len(table):
-        sys.exit(f"PLY has {len(polys)} faces, patches.csv {len(table)} rows")
+        sys.exit(f"PLY has {len(polys)} faces, patches.csv {len(table)} rows (solve with "
+                 "--elements off: the export then draws the patches)")
     summary = json.loads((sdir / "summary.json").read_text())
     return table, polys, summary, wall
 
