@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Check a radiosity solve against Radiance on the same model, patch by patch.
 
-1. ``radiosity solve MODEL --out DIR/solve --save DIR/solve/solution.rad [--solve-args]``, then
-   ``radiosity export`` to a PLY (one face per patch, in patch order) for the patch polygons;
+1. ``radiosity solve MODEL --out DIR/solve --save DIR/solve/solution.rad --elements off
+   [--solve-args]``, then ``radiosity export`` to a PLY (one face per patch, in patch order: the
+   export draws the elements when there are any) for the patch polygons;
    the tool's irradiance per patch is (B - E) / rho from ``patches.csv``.
 2. The same OBJ/MTL written as a Radiance scene (``objrad.py``: ``plastic`` with the tool's rho,
    ``light`` with radiance Ke), ``oconv``, and ``rtrace -I`` at stratified points inside each
@@ -37,43 +38,10 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import objrad  # noqa: E402
+from common import (BINARY_HELP, LUMA, ROOT, oconv, parse_emit, radiance_env,  # noqa: E402
+                    radiosity_binary, ray_lines, read_patches, rtrace_rgb, run)
 
-ROOT = Path(__file__).resolve().parents[2]
-LUMA = np.array([0.2126, 0.7152, 0.0722])
 STRATA = 8
-
-
-# --------------------------------------------------------------------------------------------
-# Tools.
-
-
-def radiance_env():
-    """(bin folder, environment with RAYPATH) of the pyradiance wheel's Radiance."""
-    import pyradiance
-
-    pkg = Path(pyradiance.__file__).parent
-    env = dict(os.environ)
-    env["RAYPATH"] = str(pkg / "lib")
-    env["PATH"] = str(pkg / "bin") + os.pathsep + env.get("PATH", "")
-    return pkg / "bin", env
-
-
-def radiosity_binary(arg: str | None) -> Path:
-    if arg:
-        return Path(arg)
-    if os.environ.get("RADIOSITY"):
-        return Path(os.environ["RADIOSITY"])
-    target = Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
-    return target / "release" / "radiosity"
-
-
-def run(cmd, **kw):
-    """Run a command; on failure print its stderr and stop with exit code 1."""
-    res = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if res.returncode != 0:
-        sys.stderr.write(f"failed: {shlex.join(map(str, cmd))}\n{res.stderr}\n")
-        sys.exit(1)
-    return res
 
 
 # --------------------------------------------------------------------------------------------
@@ -85,14 +53,19 @@ def solve(binary: Path, model: Path, out: Path, solve_args: list[str]):
     sdir = out / "solve"
     sdir.mkdir(parents=True, exist_ok=True)
     sol = sdir / "solution.rad"
+    # The patch polygons come from the export, which draws the adaptive elements when the
+    # solution has them: without elements it is one face per patch (patches.csv is the same
+    # either way; the elements never feed back into the patches).
+    no_elements = [] if any(a.startswith("--elements") for a in solve_args) else ["--elements", "off"]
     t0 = time.perf_counter()
-    run([binary, "solve", model, "--out", sdir, "--save", sol, "--quiet", *solve_args])
+    run([binary, "solve", model, "--out", sdir, "--save", sol, "--quiet", *no_elements, *solve_args])
     wall = time.perf_counter() - t0
     run([binary, "export", sol, "--out", sdir / "patches.ply", "--quiet"])
-    table = np.genfromtxt(sdir / "patches.csv", delimiter=",", names=True)
+    table = read_patches(sdir / "patches.csv")
     polys = read_ply_faces(sdir / "patches.ply")
     if len(polys) != len(table):
-        sys.exit(f"PLY has {len(polys)} faces, patches.csv {len(table)} rows")
+        sys.exit(f"PLY has {len(polys)} faces, patches.csv {len(table)} rows (solve with "
+                 "--elements off: the export then draws the patches)")
     summary = json.loads((sdir / "summary.json").read_text())
     return table, polys, summary, wall
 
@@ -183,29 +156,18 @@ class Radiance:
     def octree(self, model, name, light_radiance=None):
         rad = self.workdir / f"{name}.rad"
         objrad.write_rad(model, rad, light_radiance)
-        oct_path = self.workdir / f"{name}.oct"
-        with open(oct_path, "wb") as f:
-            res = subprocess.run([self.bin / "oconv", "-f", rad], stdout=f,
-                                 stderr=subprocess.PIPE, env=self.env)
-        if res.returncode != 0:
-            sys.exit(f"oconv failed: {res.stderr.decode()}")
-        return oct_path
+        return oconv(self.bin, self.env, [rad], self.workdir / f"{name}.oct")
 
     def irradiance(self, octree: Path, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
         """RGB irradiance at each origin on a surface facing dirs."""
-        text = "\n".join(f"{o[0]:.9g} {o[1]:.9g} {o[2]:.9g} {d[0]:.9g} {d[1]:.9g} {d[2]:.9g}"
-                         for o, d in zip(origins, dirs)) + "\n"
         t0 = time.perf_counter()
-        res = subprocess.run([self.bin / "rtrace", *self.opts, octree], input=text,
-                             capture_output=True, text=True, env=self.env)
+        res = subprocess.run([self.bin / "rtrace", *self.opts, octree],
+                             input=ray_lines(origins, dirs), capture_output=True, text=True,
+                             env=self.env)
         self.seconds += time.perf_counter() - t0
         if res.returncode != 0:
             sys.exit(f"rtrace failed: {res.stderr}")
-        vals = np.array([[float(x) for x in line.split()[:3]]
-                         for line in res.stdout.splitlines() if line.strip()])
-        if len(vals) != len(origins):
-            sys.exit(f"rtrace gave {len(vals)} values for {len(origins)} points")
-        return vals
+        return rtrace_rgb(res.stdout, len(origins))
 
 
 def points_for(polys, ids, k, seed):
@@ -338,17 +300,6 @@ def compare_solve(label, table, summary, wall, ids, weight, y_ref, model, n_wors
     }
 
 
-def parse_emit(solve_args):
-    """--emit MATERIAL=R,G,B flags among the solve's arguments."""
-    emit = {}
-    for i, a in enumerate(solve_args):
-        if a == "--emit" and i + 1 < len(solve_args):
-            name, _, val = solve_args[i + 1].rpartition("=")
-            emit[name] = tuple(float(x) for x in val.split(","))
-    return emit
-
-
-
 def radiance_reference(args, model, rad, table, polys, ids, weight):
     """Radiance's irradiance at the sampled patches' points: runs, noise, lit-behind ids."""
     t0 = time.perf_counter()
@@ -403,8 +354,7 @@ def main():
     ap.add_argument("--also", action="append", default=[], metavar="ARGS",
                     help="another solve (its extra flags, quoted) checked against the same "
                     "reference; it must mesh the same patches; repeatable")
-    ap.add_argument("--radiosity", help="the radiosity binary (default $RADIOSITY, else "
-                    "$CARGO_TARGET_DIR or target, /release/radiosity)")
+    ap.add_argument("--radiosity", help=BINARY_HELP)
     ap.add_argument("--samples", type=int, default=1000, help="patches sampled (default 1000)")
     ap.add_argument("--points", type=int, default=8, help="points per patch (default 8)")
     ap.add_argument("--seed", type=int, default=1, help="seed of the sampling")
@@ -429,9 +379,7 @@ def main():
     model_path = args.model.resolve()
     out = (args.out or ROOT / "out" / "check" / model_path.stem).resolve()
     out.mkdir(parents=True, exist_ok=True)
-    binary = radiosity_binary(args.radiosity)
-    if not binary.is_file():
-        sys.exit(f"no radiosity binary at {binary} (cargo build --release, or --radiosity)")
+    binary = radiosity_binary(args.radiosity, must_exist=True)
 
     # The tool: the first solve fixes the patches and the sample.
     arg_sets = [shlex.split(args.solve_args)] + [shlex.split(a) for a in args.also]
@@ -449,7 +397,7 @@ def main():
     ids, weight = sample_patches(table, args.samples, args.seed)
 
     # Radiance, or its saved result for the same model, points and settings (--reuse).
-    model = objrad.read_obj(model_path, parse_emit(arg_sets[0]))
+    model = objrad.read_obj(model_path, binary, parse_emit(arg_sets[0]))
     rad = Radiance(args, out)
     key = {"model": str(model_path), "bytes": model_path.stat().st_size,
            "mtime": model_path.stat().st_mtime, "rtrace": " ".join(rad.opts),

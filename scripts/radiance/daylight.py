@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Check the tool's daylight (issue 14) against Radiance: work-plane illuminance on a sensor grid.
+"""Check the tool's daylight (sky, sun, glazing, sensor grid) against Radiance: work-plane illuminance on a sensor grid.
 
 1. The tool: ``radiosity solve MODEL --sky KIND [--sky-illuminance LUX] [--sun ALT,AZI | --sun
    off] --ground-reflectance G --zenith X,Y,Z --north X,Y,Z --grid HEIGHT,SPACING (or
@@ -16,8 +16,8 @@
    Radiance's own noise (leave-one-out over its runs: :func:`noise`), the tool's solve time and
    Radiance's time for one run (:func:`speed`).
 
-``--points-only`` (automatic when the binary does not know ``--sky``, or is missing) runs only
-Radiance: the grid is made here (rule in :func:`make_grid`) or read from ``--grid POINTS.csv``,
+``--points-only`` (automatic when the binary does not know ``--sky``) runs only Radiance (the
+materials still come from the tool's ``radiosity info --json``, so the binary must exist): the grid is made here (rule in :func:`make_grid`) or read from ``--grid POINTS.csv``,
 and the sky's numbers are computed here the tool's way (:class:`SkySettings`). It writes
 ``DIR/radiance-grid.csv`` and ``DIR/report.json`` and reports Radiance's noise and time.
 
@@ -40,7 +40,6 @@ import json
 import math
 import os
 import re
-import resource
 import shlex
 import subprocess
 import sys
@@ -52,11 +51,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import objrad  # noqa: E402
-from check import radiance_env, radiosity_binary, run  # noqa: E402
+from common import (BINARY_HELP, EFFICACY, PHOTOPIC, ROOT, children_cpu, oconv,  # noqa: E402
+                    parse_emit, radiance_env, radiosity_binary, ray_lines, rtrace_rgb, run)
 
-ROOT = Path(__file__).resolve().parents[2]
-EFFICACY = 179.0  # lm/W, Radiance's white-light efficacy (as the tool's)
-PHOTOPIC = np.array([0.265, 0.670, 0.065])  # Radiance's RGB -> luminance weights (for lux)
 DEFAULT_SKY_ILLUMINANCE = 10_000.0  # lux, the tool's default for overcast (and uniform)
 SUN_DIAMETER_RADIANCE = 0.5  # degrees, gensky's sun
 BARS = {"area_averaged": 0.05, "median_point": 0.10, "speed": 10.0}
@@ -395,17 +392,10 @@ class Radiance:
         objrad.write_rad(model, scene)
         skyfile = self.workdir / "sky.rad"
         skyfile.write_text(sky_rad(sky))
-        oct_path = self.workdir / f"{name}.oct"
-        with open(oct_path, "wb") as f:
-            res = subprocess.run([self.bin / "oconv", "-f", skyfile, scene], stdout=f,
-                                 stderr=subprocess.PIPE, env=self.env)
-        if res.returncode != 0:
-            sys.exit(f"oconv failed: {res.stderr.decode()}")
-        return oct_path
+        return oconv(self.bin, self.env, [skyfile, scene], self.workdir / f"{name}.oct")
 
     def _rtrace(self, opts, octree, origins, dirs):
-        text = "".join(f"{o[0]:.9g} {o[1]:.9g} {o[2]:.9g} {d[0]:.9g} {d[1]:.9g} {d[2]:.9g}\n"
-                       for o, d in zip(origins, dirs))
+        text = ray_lines(origins, dirs)
         t0, c0 = time.perf_counter(), children_cpu()
         res = subprocess.run([self.bin / "rtrace", *opts, octree], input=text,
                              capture_output=True, text=True, env=self.env)
@@ -420,11 +410,7 @@ class Radiance:
         out, seconds = self._rtrace(self.opts, octree, origins, dirs)
         self.run_seconds.append(seconds)
         self.run_cpu.append(self.last_cpu)
-        vals = np.array([[float(x) for x in line.split()[:3]]
-                         for line in out.splitlines() if line.strip()])
-        if len(vals) != len(origins):
-            sys.exit(f"rtrace gave {len(vals)} values for {len(origins)} points")
-        return vals
+        return rtrace_rgb(out, len(origins))
 
     def trace_names(self, octree, origins, dirs) -> list:
         """The name of the first surface each ray meets (sky or ground when none)."""
@@ -433,14 +419,6 @@ class Radiance:
         if len(names) != len(origins):
             sys.exit(f"rtrace gave {len(names)} names for {len(origins)} rays")
         return names
-
-
-def children_cpu() -> float:
-    """CPU seconds (user + system) of this script's finished children: rtrace and the
-    processes it forks for -n. With the tool's own ``cpu_seconds`` these compare the work each
-    did, which a busy machine leaves as it is (wall seconds it does not)."""
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def radiance_lux(rad: Radiance, octree, pts_local, nrm_local, repeat: int, seed: int):
@@ -615,7 +593,7 @@ def tool_knows_sky(binary: Path) -> bool:
 
 
 def tool_args(args) -> list:
-    """The tool's sky and grid flags from ours (the contract of issue 14)."""
+    """The tool's sky and grid flags from ours (the flags of `radiosity solve`: --sky, --sun, --grid …)."""
     out = ["--sky", args.sky]
     if args.sky_illuminance is not None:
         out += ["--sky-illuminance", f"{args.sky_illuminance:g}"]
@@ -696,13 +674,10 @@ def parse_args(argv=None):
                     help="points-only grid: regex of the floor materials (default ^floor)")
     ap.add_argument("--levels", help="points-only grid: the floor levels kept, as indices "
                     "from the lowest (0), comma-separated (default all)")
-    ap.add_argument("--tf-rule", choices=objrad.TF_RULES, default="tool",
-                    help="how Tf / d / Tr / illum read (objrad.py): the tool's rule")
     ap.add_argument("--points-only", action="store_true",
                     help="run Radiance alone on a grid made here (automatic when the tool does "
                     "not know --sky)")
-    ap.add_argument("--radiosity", help="the radiosity binary (default $RADIOSITY, else "
-                    "$CARGO_TARGET_DIR or target, /release/radiosity)")
+    ap.add_argument("--radiosity", help=BINARY_HELP)
     ap.add_argument("--solve-args", default="", help="extra flags for radiosity solve, quoted")
     ap.add_argument("--repeat", type=int, default=2,
                     help="Radiance runs (their spread is its noise; the reference is their "
@@ -779,7 +754,8 @@ def main(argv=None):
         sky = here_sky
 
     m = frame_matrix(sky.zenith, sky.north)
-    model = objrad.read_obj(model_path, tf_rule=args.tf_rule)
+    emit = parse_emit(shlex.split(args.solve_args))
+    model = objrad.read_obj(model_path, binary, emit)
     normals = []
     for face in model.faces:
         n = objrad.polygon_normal(model.vertices[face])
@@ -795,7 +771,7 @@ def main(argv=None):
         if re.fullmatch(r"[0-9.eE+-]+,[0-9.eE+-]+", args.grid):
             height, spacing = (float(x) for x in args.grid.split(","))
             kept = [int(x) for x in args.levels.split(",")] if args.levels else None
-            pts, nrm = make_grid(objrad.read_obj(model_path, tf_rule=args.tf_rule), m, height,
+            pts, nrm = make_grid(objrad.read_obj(model_path, binary, emit), m, height,
                                  spacing, args.floor_material, kept)
             keep = drop_inside(rad, octree, model, pts @ m.T, normals_local)
             if (~keep).any():

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Write the project's daylit test scenes (issue 14) as OBJ + MTL, deterministic.
+"""Write the project's daylit test scenes (side-lit, deep-plan, atrium) as OBJ + MTL, deterministic.
 
 Metres, +Y up, north = -Z (the tool's defaults: ``--zenith 0,1,0 --north 0,0,-1``), so east is
 +X and **south is +Z**. Every building is modelled inside and out: walls, floors and roofs are
@@ -50,10 +50,14 @@ pane is a single polygon (the tool lets a transmissive face pass rays from both 
 from __future__ import annotations
 
 import argparse
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import r6  # noqa: E402
 
 SCENES = ("sidelit", "sidelit-open", "deepplan", "atrium")
 MTL_NAME = "daylit.mtl"
@@ -75,11 +79,6 @@ MATERIALS = {
 SHELL = 1  # solid kinds: the building's fabric, then furniture
 KIND_MATERIAL = {2: "desk", 3: "partition", 4: "wall"}
 DESK, PARTITION, PARAPET = 2, 3, 4
-
-
-def r6(x: float) -> float:
-    """A coordinate rounded to the micrometre (so equal coordinates compare equal)."""
-    return round(float(x), 6) + 0.0
 
 
 Box = tuple  # (x0, x1, y0, y1, z0, z1)

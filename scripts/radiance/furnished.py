@@ -37,10 +37,14 @@ import math
 import random
 import struct
 import zlib
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import r6  # noqa: E402
 
 VARIANTS = ("plain", "doubled", "inside-out")
 
@@ -51,11 +55,6 @@ B_X = (6.2, 10.2)
 Z_RANGE = (-5.0, 0.0)
 DOOR_Z = (-1.6, -0.7)
 DOOR_TOP = 2.1
-
-
-def r6(x: float) -> float:
-    """Coordinates rounded to the micrometre, so faces meant to touch have equal coordinates."""
-    return round(float(x), 6) + 0.0
 
 
 # --------------------------------------------------------------------------------------------

@@ -1,62 +1,60 @@
-"""OBJ + MTL reading as the radiosity tool reads them, and the Radiance scene written from them.
+"""An OBJ with the tool's materials, and the Radiance scene written from them.
 
-The tool's model (README "Conventions", docs/design.md §1): rho = Kd x the mean linear colour of
-``map_Kd`` (8/16-bit texels decoded from sRGB), a channel of 1 or more clamped to 0.98; a
-material without Kd is grey 0.5, as are faces without a material; ``Ke`` is emitted *radiance*
-(W/sr/m^2), so a Lambertian emitter's radiosity is E = pi Ke. In Radiance a diffuse surface of
-reflectance rho is ``plastic`` with rho, no specularity; an emitter of radiance Ke is ``light``
-with Ke (Radiance's ``light`` radiance is W/sr/m^2 too). Radiance's materials are two-sided, its
-lights one-sided (their backs are black), and ``light`` does not reflect: see
-:func:`write_rad` for emitters that also reflect.
+The geometry (vertices, faces, ``usemtl``) is read here; the materials are not: they come from
+``radiosity info --json`` (:func:`common.tool_info`), which reports each material exactly as
+the tool's loader made it, so there is one reader of the MTL (``src/scene/obj/mtl.rs``) and
+nothing here to drift from it. Per material the JSON gives ``rho`` (RGB, after the clamp to
+0.98), ``rho_source`` (``Kd``, ``Kd`` x a texture's mean colour, clamped, the default grey),
+``ke`` (emitted radiance, W/sr/m^2, after ``--emit``), ``emission`` (E = pi Ke, W/m^2) and
+``transmittance_rgb`` (the glazing's straight-through transmittance per channel, after the cut
+to rho_c + T_c <= 1; 0 when opaque). Faces with no (known) material take the tool's default
+grey (named ``default``, or ``default-grey`` when the library has a ``default``).
 
-Glazing (issue 14): a material with transmission in its MTL passes light straight through with
-transmittance T, read by the tool's rule (``src/scene/obj/mtl.rs``, ``transmittance``): ``d`` < 1
-(or ``Tr`` > 0 without ``d``) gives T = (1 - d) x mean ``Tf`` (1 without ``Tf``); else a
-transparency ``illum`` (4, 6, 7, 9) with ``Tf`` gives T = mean ``Tf``; else a ``Tf`` strictly
-between 0 and 1 in some channel gives T = mean ``Tf``; else opaque (exporters write ``Tf 1 1 1``
-with ``d 1`` on opaque materials: Sponza's and Sibenik's MTL do). The same rule per channel
-gives the colour T_c (e.g. (1 - d) x ``Tf``_c): grey glazing (equal channels) has T in every
-channel, at most 1 - max rho; tinted glazing (channels that differ) keeps its colour, each
-channel at most 1 - rho_c (docs/design.md §9, "Tinted glazing"). Its ``Kd`` (rho) stays the
-pane's diffuse reflectance. In Radiance a grey pane is ``trans`` with no specular reflection
-(spec 0) and all its transmission specular (tspec 1): its diffuse reflectance is c (1 - t) and
-its straight-through transmittance c t, so c = rho + T and t = T / (rho + T) match the pane
-exactly (see :func:`trans_parameters`). ``glass`` would not do: it adds Fresnel reflection and
-its parameter is a transmissivity, not a transmittance. Radiance's shadow rays (the sun) and
+In Radiance a diffuse surface of reflectance rho is ``plastic`` with rho, no specularity; an
+emitter of radiance Ke is ``light`` with Ke (Radiance's ``light`` radiance is W/sr/m^2 too).
+Radiance's materials are two-sided, its lights one-sided (their backs are black), and
+``light`` does not reflect: see :func:`write_rad` for emitters that also reflect.
+
+Glazing: a grey pane (rho, T) is ``trans`` with no specular reflection (spec 0) and all its
+transmission specular (tspec 1): its diffuse reflectance is c (1 - t) and its straight-through
+transmittance c t, so c = rho + T and t = T / (rho + T) match the pane exactly (see
+:func:`trans_parameters`). ``glass`` would not do: it adds Fresnel reflection and its
+parameter is a transmissivity, not a transmittance. Radiance's shadow rays (the sun) and
 ambient rays go through ``trans`` straight on with factor c t (``scripts/radiance/README.md``,
 "Daylight", has the check). ``trans`` has one t for the three channels, so a pane whose
-T_c / (rho_c + T_c) differs by channel (tinted glass) is written as ``BRTDfunc`` instead:
-specular transmission T_c per channel, diffuse reflectance rho_c on both sides, nothing else
-(:func:`brtd_pane`); Radiance's ``m_brdf`` casts its transmitted ray for shadow and ambient
-rays too, with the coefficient T_c.
+T_c / (rho_c + T_c) differs by channel (tinted glass, docs/design.md §9) is written as
+``BRTDfunc`` instead: specular transmission T_c per channel, diffuse reflectance rho_c on both
+sides, nothing else (:func:`brtd_pane`); Radiance's ``m_brdf`` casts its transmitted ray for
+shadow and ambient rays too, with the coefficient T_c.
 """
 
 from __future__ import annotations
 
 import math
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
 
-MAX_REFLECTANCE = 0.98
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import common  # noqa: E402
+
 DEFAULT_GREY = 0.5
+DEFAULT_NAMES = ("default-grey", "default")  # the tool's grey for faces without a material
 
 
 @dataclass
 class Material:
+    """One material as ``radiosity info --json`` reports it."""
+
     name: str
     rho: tuple = (DEFAULT_GREY,) * 3
     ke: tuple = (0.0, 0.0, 0.0)
     rho_source: str = "default"
-    # Straight-through transmittance T per channel (0: opaque), and the MTL values it came from.
+    # Straight-through transmittance T per channel (0: opaque).
     transmittance: tuple = (0.0, 0.0, 0.0)
-    tf: tuple | None = None
-    d: float | None = None
-    tr: float | None = None
-    illum: int | None = None
 
     @property
     def emits(self) -> bool:
@@ -95,118 +93,68 @@ def logical_lines(text: str):
         yield re.sub(r"(^|\s)#.*$", "", buf).strip()
 
 
-def map_file(value: str) -> str:
-    """The file name after a ``map_Kd`` statement's options (as the tool skips them)."""
-    words = value.split()
-    one_word = {"-blendu", "-blendv", "-cc", "-clamp", "-imfchan", "-type", "-colorspace"}
-    numbers = {"-bm": 1, "-boost": 1, "-texres": 1, "-mm": 2}
-
-    def is_num(w):
-        try:
-            float(w)
-            return True
-        except ValueError:
-            return False
-
-    i = 0
-    while i < len(words) and words[i].startswith("-") and not is_num(words[i]):
-        opt = words[i]
-        i += 1
-        if opt in one_word:
-            i += 1
-            continue
-        for _ in range(numbers.get(opt, 3)):
-            if i < len(words) and is_num(words[i]):
-                i += 1
-            else:
-                break
-    return " ".join(words[i:])
+def source_text(src: dict) -> str:
+    """The tool's ``rho_source`` object in a few words (for the comments of the scene)."""
+    kind = src.get("kind", "?")
+    if kind == "kd_times_texture":
+        return f"Kd x mean({src.get('file')})"
+    if kind == "texture_not_loaded":
+        return f"{source_text(src.get('fallback', {}))} ({src.get('file')} not loaded)"
+    if kind == "clamped":
+        return f"{source_text(src.get('from', {}))}, clamped"
+    return {"kd": "Kd"}.get(kind, kind)
 
 
-def srgb_to_linear(v):
-    v = np.asarray(v, dtype=np.float64)
-    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
-
-
-def texture_mean(path: Path):
-    """The mean colour of an image in linear light (integer texels read as sRGB, float linear),
-    or None when it does not load."""
-    try:
-        img = Image.open(path)
-        img.load()
-    except Exception:
-        return None
-    if img.mode in ("I;16", "I;16B", "I;16L", "I"):
-        a = np.asarray(img, dtype=np.float64) / 65535.0
-        lin = srgb_to_linear(a)
-        return (float(lin.mean()),) * 3
-    if img.mode == "F":
-        m = float(np.asarray(img, dtype=np.float64).mean())
-        return (m, m, m)
-    a = np.asarray(img.convert("RGB"), dtype=np.float64) / 255.0
-    lin = srgb_to_linear(a).reshape(-1, 3).mean(axis=0)
-    return tuple(float(x) for x in lin)
-
-
-def find_file(folder: Path, name: str) -> Path:
-    """A file named in an MTL: as written, with ``\\`` read as ``/``, or in another letter case."""
-    for cand in (folder / name, folder / name.replace("\\", "/")):
-        if cand.is_file():
-            return cand
-    cand = folder / name.replace("\\", "/")
-    if cand.parent.is_dir():
-        for p in cand.parent.iterdir():
-            if p.is_file() and p.name.lower() == cand.name.lower():
-                return p
-    return folder / name
-
-
-TF_RULES = ("tool",)
-
-
-def numbers(rest: str) -> list:
-    """The words of a statement that read as numbers (options such as ``-halo`` or ``xyz``
-    skipped)."""
-    out = []
-    for w in rest.split():
-        try:
-            out.append(float(w))
-        except ValueError:
-            continue
+def materials_from_info(info: dict) -> dict:
+    """Materials by name from ``radiosity info --json``."""
+    out = {}
+    for m in info["materials"]:
+        t = m.get("transmittance_rgb") or [m.get("transmittance", 0.0)] * 3
+        out[m["name"]] = Material(m["name"], tuple(m["rho"]), tuple(m["ke"]),
+                                  source_text(m.get("rho_source", {})), tuple(t))
     return out
 
 
-def transmittance(m: Material, tf_rule: str, warnings: list) -> tuple:
-    """T per channel from the material's Tf / d / Tr / illum, the tool's rule (see the module
-    docstring): grey (T, T, T) when Tf's channels are equal, else Tf's colour T_c;
-    ``tf_rule`` is kept for the command line and must be "tool"."""
-    mean = (lambda c: sum(c) / 3.0)
-    opacity = m.d if m.d is not None else (1.0 - m.tr if m.tr is not None else None)
-    colour, scale = None, 1.0
-    if opacity is not None and opacity < 1.0:
-        t = (1.0 - opacity) * (mean(m.tf) if m.tf is not None else 1.0)
-        colour, scale = m.tf, 1.0 - opacity
-    elif m.tf is not None and m.illum in (4, 6, 7, 9):
-        t = mean(m.tf)
-        colour = m.tf
-    elif m.tf is not None and any(0.0 < x < 1.0 for x in m.tf):
-        t = mean(m.tf)
-        colour = m.tf
-    else:
-        t = 0.0
-    if t > 0.0 and colour is not None and len(set(colour)) > 1:
-        # Tinted: each channel at most 1 - rho_c (the tool's `glazing` in mtl.rs).
-        tc = tuple(scale * x for x in colour)
-        kept = tuple(min(x, max(0.0, 1.0 - r)) for x, r in zip(tc, m.rho))
-        if kept != tc:
-            warnings.append(f"material {m.name!r}: transmittance {tc} cut to {kept} "
-                            "(rho_c + T_c <= 1)")
-        return kept
-    room = max(0.0, 1.0 - max(m.rho))
-    if t > room:
-        warnings.append(f"material {m.name!r}: transmittance {t:g} cut to {room:g} (rho + T <= 1)")
-        t = room
-    return (t, t, t)
+def read_obj(path: Path, binary: Path | None = None, emit: dict | None = None) -> Model:
+    """An OBJ file's polygons, with the materials the tool loads for it (``radiosity info
+    --json``, :func:`common.tool_info`); ``emit`` maps material names to Ke (the tool's
+    ``--emit``), passed to the tool; ``binary`` defaults to :func:`common.radiosity_binary`."""
+    path = Path(path)
+    binary = binary or common.radiosity_binary(None, must_exist=True)
+    info = common.tool_info(binary, path, emit)
+    lib = materials_from_info(info)
+    warnings: list = list(info.get("warnings", []))
+    verts, faces, face_mat = [], [], []
+    index: dict = {}
+    materials: list = []
+    current = None
+
+    fallback = next((lib[n] for n in DEFAULT_NAMES if n in lib), None) or Material("default")
+
+    def material_index(name):
+        m = lib.get(name) if name is not None else None
+        m = m or fallback
+        if m.name not in index:
+            index[m.name] = len(materials)
+            materials.append(m)
+        return index[m.name]
+
+    raw_faces = []
+    for line in logical_lines(path.read_text(errors="replace")):
+        word, _, rest = line.partition(" ")
+        if word == "v":
+            verts.append([float(x) for x in rest.split()[:3]])
+        elif word == "f":
+            raw_faces.append(([int(t.split("/")[0]) for t in rest.split()], current))
+        elif word == "usemtl":
+            current = rest.strip()
+    nv = len(verts)
+    for idx, mat in raw_faces:
+        ids = [i - 1 if i > 0 else nv + i for i in idx]
+        faces.append(ids)
+        face_mat.append(material_index(mat))
+    return Model(np.array(verts, dtype=np.float64).reshape(-1, 3), faces, face_mat, materials,
+                 warnings)
 
 
 def trans_parameters(rho, t):
@@ -216,7 +164,7 @@ def trans_parameters(rho, t):
     channels differ (then the match is not exact). Returns (c, t_R, exact)."""
     c = tuple(r + x for r, x in zip(rho, t))
     ratios = [x / ci if ci > 0 else 0.0 for x, ci in zip(t, c)]
-    w = (0.2126, 0.7152, 0.0722)
+    w = tuple(common.LUMA)
     num = sum(wi * x for wi, x in zip(w, t))
     den = sum(wi * ci for wi, ci in zip(w, c))
     t_r = num / den if den > 0 else 0.0
@@ -231,112 +179,6 @@ def brtd_pane(rho, t) -> str:
     channel, where ``trans`` cannot be (its t is one number)."""
     return ("10 0 0 0 " + " ".join(f"{x:.9g}" for x in t) + " 0 0 0 .\n0\n"
             + "9 " + " ".join(f"{x:.9g}" for x in tuple(rho) * 2) + " 0 0 0")
-
-
-def read_mtl(path: Path, warnings: list, tf_rule: str = "tool") -> dict:
-    """Materials by name from one MTL file."""
-    mats, cur, tex = {}, None, {}
-    kd_seen = {}
-    for line in logical_lines(path.read_text(errors="replace")):
-        word, _, rest = line.partition(" ")
-        rest = rest.strip()
-        if word == "newmtl":
-            cur = Material(rest)
-            mats[rest] = cur
-        elif cur is None:
-            continue
-        elif word == "Kd":
-            cur.rho = tuple(float(x) for x in rest.split()[:3])
-            cur.rho_source = "Kd"
-            kd_seen[cur.name] = True
-        elif word == "Ke":
-            cur.ke = tuple(float(x) for x in rest.split()[:3])
-        elif word == "Tf":
-            vals = numbers(rest)[:3]
-            if vals:
-                cur.tf = tuple((vals * 3)[:3]) if len(vals) < 3 else tuple(vals)
-        elif word == "d":
-            vals = numbers(rest)
-            if vals:
-                cur.d = vals[0]
-        elif word == "illum":
-            vals = numbers(rest)
-            if vals:
-                cur.illum = int(vals[0])
-        elif word == "Tr":
-            vals = numbers(rest)
-            if vals:
-                cur.tr = vals[0]
-        elif word == "map_Kd":
-            tex[cur.name] = map_file(rest)
-    for name, file in tex.items():
-        m = mats[name]
-        mean = texture_mean(find_file(path.parent, file)) if file else None
-        if mean is None:
-            warnings.append(f"texture {file!r} of {name!r} not loaded: Kd alone")
-            continue
-        kd = m.rho if kd_seen.get(name) else (1.0, 1.0, 1.0)
-        m.rho = tuple(k * t for k, t in zip(kd, mean))
-        m.rho_source = f"Kd x mean({file})"
-    for m in mats.values():
-        if any(r >= 1.0 for r in m.rho):
-            m.rho = tuple(MAX_REFLECTANCE if r >= 1.0 else r for r in m.rho)
-            m.rho_source += " clamped"
-        m.transmittance = transmittance(m, tf_rule, warnings)
-    return mats
-
-
-def read_obj(path: Path, emit: dict | None = None, tf_rule: str = "tool") -> Model:
-    """An OBJ file with its MTL libraries; ``emit`` maps material names to Ke (the tool's
-    ``--emit``); ``tf_rule``: the tool's glazing rule (:data:`TF_RULES`)."""
-    path = Path(path)
-    warnings: list = []
-    verts, faces, face_mat = [], [], []
-    lib: dict = {}
-    index: dict = {}
-    materials: list = []
-    current = None
-
-    def material_index(name):
-        if name not in index:
-            m = lib.get(name)
-            if m is None:
-                warnings.append(f"material {name!r} not defined: grey")
-                m = Material(name)
-            index[name] = len(materials)
-            materials.append(m)
-        return index[name]
-
-    raw_faces = []
-    for line in logical_lines(path.read_text(errors="replace")):
-        word, _, rest = line.partition(" ")
-        if word == "v":
-            verts.append([float(x) for x in rest.split()[:3]])
-        elif word == "f":
-            raw_faces.append(([int(t.split("/")[0]) for t in rest.split()], current))
-        elif word == "usemtl":
-            current = rest.strip()
-        elif word == "mtllib":
-            name = rest.strip()
-            cands = [name] if (path.parent / name).exists() else name.split()
-            for n in cands:
-                p = path.parent / n
-                if p.is_file():
-                    lib.update(read_mtl(p, warnings, tf_rule))
-                else:
-                    warnings.append(f"material library {n!r} missing")
-    nv = len(verts)
-    for idx, mat in raw_faces:
-        ids = [i - 1 if i > 0 else nv + i for i in idx]
-        faces.append(ids)
-        face_mat.append(material_index(mat if mat is not None else "default"))
-    for name, ke in (emit or {}).items():
-        if name in index:
-            materials[index[name]].ke = tuple(ke)
-        else:
-            warnings.append(f"--emit {name}: no faces use it")
-    return Model(np.array(verts, dtype=np.float64).reshape(-1, 3), faces, face_mat, materials,
-                 warnings)
 
 
 def polygon_normal(p: np.ndarray) -> np.ndarray:
@@ -372,7 +214,7 @@ def write_rad(model: Model, path: Path, light_radiance: dict | None = None):
     ``light`` per emitting material (radiance Ke), or per emitting face when
     ``light_radiance[face]`` gives that face's radiance (emitters that also reflect: Ke + rho
     H / pi, found by :func:`check.light_iteration`)."""
-    out = ["# written by scripts/radiance/objrad.py from the OBJ/MTL"]
+    out = ["# written by scripts/radiance/objrad.py: the OBJ's faces, the tool's materials"]
     for k, m in enumerate(model.materials):
         if m.emits:
             out.append(f"# {m.name}: Ke {m.ke} (W/sr/m^2), rho {m.rho} (not reflected by light)")

@@ -13,7 +13,7 @@
    Radiance's time at the tool's error.
 3. Compared on luminance Y = 0.2126 R + 0.7152 G + 0.0722 B per pixel, on the pixels both see
    with Y above ``--threshold`` times the reference's mean: the mean relative error
-   |Y - Y_ref| / Y_ref (the issue's bar: 5 %), its median, the signed mean, the share above
+   |Y - Y_ref| / Y_ref (the bar aimed at: 5 %), its median, the signed mean, the share above
    10 %, and the same after a 3 x 3 box blur of both (what is left when pixel noise and edge
    aliasing are averaged out: the bias).
 
@@ -35,7 +35,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import resource
 import shlex
 import subprocess
 import sys
@@ -47,15 +46,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import check  # noqa: E402
 import objrad  # noqa: E402
-
-LUMA = np.array([0.2126, 0.7152, 0.0722])
-
-
-def vec(text: str) -> np.ndarray:
-    v = np.array([float(x) for x in text.split(",")])
-    if v.shape != (3,):
-        raise argparse.ArgumentTypeError(f"expected X,Y,Z, got {text!r}")
-    return v
+from common import (BINARY_HELP, LUMA, ROOT, children_cpu, parse_emit, radiance_env,  # noqa: E402
+                    radiosity_binary, run, vec)
 
 
 def read_hdr(path: Path, env, binary: Path) -> np.ndarray:
@@ -72,13 +64,6 @@ def read_hdr(path: Path, env, binary: Path) -> np.ndarray:
     if data.size != h * w * 3:
         sys.exit(f"{path}: {data.size} values for {w}x{h} pixels")
     return data.reshape(h, w, 3).astype(np.float64)
-
-
-def children_cpu() -> float:
-    """CPU seconds (user + system) of the children waited for so far: the tool's threads and
-    rpict's process alike, unaffected by what else the machine runs (wall times are not)."""
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
 
 
 def blur3(y: np.ndarray) -> np.ndarray:
@@ -149,7 +134,7 @@ def main():
     ap.add_argument("--render-args", default="",
                     help="extra flags for radiosity render --shading gather, quoted "
                          "(e.g. --pixel-rays 32 --supersample 4)")
-    ap.add_argument("--radiosity", help="the radiosity binary (default as check.py)")
+    ap.add_argument("--radiosity", help=BINARY_HELP)
     ap.add_argument("--rpict", default="-ab 8 -ad 4096 -as 2048 -aa 0.05 -ar 1024 -lr -12 "
                     "-lw 1e-5 -dj 0 -ds 0.02 -dt 0 -dc 1",
                     help="rpict settings of the reference (default: converged, see the README)")
@@ -172,12 +157,10 @@ def main():
     args = ap.parse_args()
 
     model_path = args.model.resolve()
-    out = (args.out or check.ROOT / "out" / "picture" / model_path.stem).resolve()
+    out = (args.out or ROOT / "out" / "picture" / model_path.stem).resolve()
     out.mkdir(parents=True, exist_ok=True)
-    binary = check.radiosity_binary(args.radiosity)
-    if not binary.is_file():
-        sys.exit(f"no radiosity binary at {binary} (cargo build --release, or --radiosity)")
-    rbin, env = check.radiance_env()
+    binary = radiosity_binary(args.radiosity, must_exist=True)
+    rbin, env = radiance_env()
     w, h = args.width, args.height
     cam = ["--eye", ",".join(f"{x:.9g}" for x in args.eye),
            "--target", ",".join(f"{x:.9g}" for x in args.target),
@@ -190,7 +173,7 @@ def main():
     sdir.mkdir(exist_ok=True)
     sol = sdir / "solution.rad"
     t0, c0 = time.perf_counter(), children_cpu()
-    check.run([binary, "solve", model_path, "--out", sdir, "--save", sol, "--quiet",
+    run([binary, "solve", model_path, "--out", sdir, "--save", sol, "--quiet",
                "--shading", "gouraud", *solve_args])
     solve_seconds = time.perf_counter() - t0
     times = {"solve": solve_seconds}
@@ -198,7 +181,7 @@ def main():
     reports = {}
     for shading, extra in (("gather", shlex.split(args.render_args)), ("gouraud", [])):
         t0, c0 = time.perf_counter(), children_cpu()
-        res = check.run([binary, "render", sol, "--out", out / f"tool-{shading}.hdr",
+        res = run([binary, "render", sol, "--out", out / f"tool-{shading}.hdr",
                          "--shading", shading, "--json", *cam, *extra])
         times[shading] = time.perf_counter() - t0
         cpu[shading] = children_cpu() - c0
@@ -213,10 +196,10 @@ def main():
            "size": [w, h], "reference": args.reference,
            "settings": args.rtrace if args.reference == "rtrace" else args.rpict,
            "oversample": args.oversample,
-           "emit": check.parse_emit(solve_args), "light_passes": args.light_passes}
+           "emit": parse_emit(solve_args), "light_passes": args.light_passes}
     saved = out / "radiance.json"
     ref_path = out / "radiance.hdr"
-    model = objrad.read_obj(model_path, check.parse_emit(solve_args))
+    model = objrad.read_obj(model_path, binary, parse_emit(solve_args))
     octree = None
 
     def octree_once():

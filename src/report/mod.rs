@@ -31,7 +31,10 @@ pub struct MaterialInfo {
     /// Where `rho` came from: `Kd`, `Kd` × a texture's mean colour, clamped, … (in JSON, an
     /// object whose `kind` says which).
     pub rho_source: RhoSource,
+    /// Emitted radiance `Ke`, W/sr/m² (after `--emit`).
     pub ke: [f64; 3],
+    /// Emitted radiosity E = π·Ke, W/m² (0 for a material that does not emit).
+    pub emission: [f64; 3],
     /// Glazing's straight-through transmittance (0: opaque): the mean of its colour.
     pub transmittance: f64,
     /// Glazing's transmittance per channel: its colour when tinted, `transmittance` in every
@@ -132,6 +135,7 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
                 rho: m.rho,
                 rho_source: m.rho_source.clone(),
                 ke: m.ke,
+                emission: m.emission(),
                 transmittance: m.transmittance,
                 transmittance_rgb: m.transmittance_rgb(),
                 polygons,
@@ -437,5 +441,53 @@ impl Summary {
             "final gather of {} patches ({} rays, {:.2} s; black patches {} → {})",
             g.patches, g.rays, g.seconds, g.black_before, g.black_after
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::MeshOptions;
+    use crate::scene::{load_obj_from_strs, LoadOptions};
+
+    /// `info --json` carries each material as the loader made it, so scripts read materials
+    /// from the tool rather than from the MTL: ρ after the clamp and where it came from,
+    /// `Ke` after `--emit`, E = π·Ke, and the glazing's transmittance per channel.
+    #[test]
+    fn the_info_json_has_every_material_as_the_loader_made_it() {
+        let obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n\
+                   usemtl white\nf 1 2 3 4\nusemtl lamp\nf 4 3 2 1\nusemtl pane\nf 1 2 3\n";
+        let mtl = "newmtl white\nKd 1.2 0.5 0.5\nnewmtl lamp\nKd 0.1 0.1 0.1\n\
+                   newmtl pane\nKd 0.1 0.1 0.1\nTf 0.2 0.6 0.3\nillum 4\n";
+        let load = LoadOptions {
+            emit: vec![("lamp".into(), [1.0, 2.0, 3.0])],
+            ..Default::default()
+        };
+        let scene = load_obj_from_strs("m.obj", obj, mtl, &load).unwrap();
+        let mesh = crate::mesh::build(&scene, &MeshOptions::default());
+        let json = serde_json::to_value(scene_info(&scene, &mesh, 1.0)).unwrap();
+        let by_name = |n: &str| {
+            json["materials"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|m| m["name"] == n)
+                .unwrap()
+                .clone()
+        };
+        let white = by_name("white");
+        assert_eq!(
+            white["rho"][0].as_f64(),
+            Some(crate::scene::MAX_REFLECTANCE)
+        );
+        assert_eq!(white["rho_source"]["kind"], "clamped");
+        assert_eq!(white["emission"][0].as_f64(), Some(0.0));
+        let lamp = by_name("lamp");
+        assert_eq!(lamp["ke"][2].as_f64(), Some(3.0));
+        let e = lamp["emission"][2].as_f64().unwrap();
+        assert!((e - 3.0 * std::f64::consts::PI).abs() < 1e-12, "{e}");
+        let pane = by_name("pane");
+        assert_eq!(pane["transmittance_rgb"][1].as_f64(), Some(0.6));
+        assert!((pane["transmittance"].as_f64().unwrap() - 1.1 / 3.0).abs() < 1e-12);
     }
 }
