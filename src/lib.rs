@@ -43,6 +43,7 @@ pub mod mesh;
 pub mod model;
 pub mod pipeline;
 pub mod progress;
+pub mod random;
 pub mod render;
 pub mod report;
 pub mod sample;

@@ -37,6 +37,7 @@ mod plan;
 mod rooms;
 mod stairs;
 
+use crate::random::mix;
 use geom::*;
 use materials::*;
 use out::*;
@@ -267,14 +268,6 @@ struct Gen<'w> {
     /// Area the attic will add at the end (axial, skew), m²: known from the plan, counted in
     /// the skew balance from the start.
     attic: (f64, f64),
-}
-
-/// A seed for one room's random choices, independent of the order rooms are written in.
-fn mix(mut z: u64) -> u64 {
-    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
 }
 
 fn build(

@@ -6,7 +6,7 @@
 
 use super::{scalar, Rgb};
 use crate::mesh::Mesh;
-use crate::solve::ray_shots::PatchPoints;
+use crate::sample::PatchPoints;
 
 /// The emitting patches, the CDF of their scalar power, their points, and the total power.
 pub(crate) struct Emitters {

@@ -59,7 +59,6 @@ pub use light_at::{LightAt, Relit, ViewHit, ViewSeen};
 use crate::mesh::Mesh;
 use crate::scene::Material;
 use crate::sky::Sky;
-use crate::solve::LightChannel;
 use emitters::Emitters;
 use glam::Vec3;
 use std::borrow::Cow;
@@ -67,6 +66,19 @@ use sun::SkyLight;
 
 /// A radiometric triple: one value per colour channel (R, G, B), f64.
 pub type Rgb = glam::DVec3;
+
+/// One light group's radiosity per patch (W/m², RGB): a *light* channel (`--per-light`), as
+/// opposed to the R, G, B colour channels every radiosity has.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightChannel {
+    pub name: String,
+    pub b: Vec<[f64; 3]>,
+}
+
+/// The per-light channel of the sky and its ground glow (`--per-light` with `--sky`).
+pub const SKY_CHANNEL: &str = "(sky)";
+/// The per-light channel of the sun.
+pub const SUN_CHANNEL: &str = "(sun)";
 
 /// The scalar the solver ranks and stops by: the mean of the three channels
 /// (`solve::scalar`'s, in that order).

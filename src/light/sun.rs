@@ -4,11 +4,9 @@
 //! (through glazing, tinted by it), L_sun·Ω_sun·cos θ each.
 
 use super::gather::{latin, stratified_var, Gathered, Spot};
-use super::{add_to, scalar, Kernel, Origin, Rgb};
+use super::{add_to, scalar, Kernel, LightChannel, Origin, Rgb, SKY_CHANNEL, SUN_CHANNEL};
 use crate::intersect::{Intersector, Ray};
 use crate::sky::{Sky, Sun};
-use crate::solve::lights::{SKY_CHANNEL, SUN_CHANNEL};
-use crate::solve::LightChannel;
 use glam::Vec3;
 use rand::Rng;
 

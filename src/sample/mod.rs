@@ -1,10 +1,14 @@
 //! Hemisphere samplers that turn a shooter's unshot energy into directions.
 //!
-//! [`polar`] is the paper's adaptive polar hemisphere sampler (Sec. 2). Directions are in the
-//! shooter's local frame (z = the patch normal); [`Frame`] maps them to world space.
+//! [`polar`] is the paper's adaptive polar hemisphere sampler (Sec. 2); [`patch_points`] draws
+//! the points on a patch that rays leave from. Directions are in the shooter's local frame
+//! (z = the patch normal); [`Frame`] maps them to world space.
 
 pub mod hemicube;
+pub mod patch_points;
 pub mod polar;
+
+pub use patch_points::PatchPoints;
 
 use glam::Vec3;
 

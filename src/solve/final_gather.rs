@@ -51,12 +51,12 @@
 //! thread count.
 
 use super::estimate::{self, ErrorMetrics, Parts};
-use super::ray_shots::PatchPoints;
 use super::{rng_for, scalar, LightChannel, Solution, Stream, TracePoint};
 use crate::intersect::Intersector;
 use crate::light::gather::{Ask, Gathered, Spot};
 use crate::light::{self, emission_and_reflectance, Kernel, LightParts, Rgb, Solved};
 use crate::mesh::Mesh;
+use crate::sample::PatchPoints;
 use crate::scene::Material;
 use crate::sky::Sky;
 use rayon::prelude::*;

@@ -19,10 +19,7 @@ pub enum GroupBy {
     Connected,
 }
 
-/// The per-light channel of the sky and its ground glow (`--per-light` with `--sky`).
-pub const SKY_CHANNEL: &str = "(sky)";
-/// The per-light channel of the sun.
-pub const SUN_CHANNEL: &str = "(sun)";
+pub use crate::light::{SKY_CHANNEL, SUN_CHANNEL};
 
 /// The light group of every patch.
 #[derive(Clone, Debug, PartialEq)]

@@ -397,7 +397,9 @@ pub(super) fn shoot_to<I: Intersector>(
         let elapsed = start.elapsed().as_secs_f64();
         let used = so_far as u64;
         let next = SolveSettings {
-            seed: super::mix(cfg.seed ^ (sols.len() as u64).wrapping_mul(0x2545_F491_4F6C_DD1D)),
+            seed: crate::random::mix(
+                cfg.seed ^ (sols.len() as u64).wrapping_mul(0x2545_F491_4F6C_DD1D),
+            ),
             energy_per_ray: Some(c1 * r1 / rays),
             max_time: match cfg.max_time {
                 Some(t) if elapsed >= t => break,
