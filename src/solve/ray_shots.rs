@@ -142,8 +142,8 @@ pub(super) struct RayCaster<'a, I> {
     jitter: bool,
     /// Smallest offset of ray origins off their patch: a few ulps of the largest coordinate.
     eps_floor: f32,
-    /// Straight-through transmittance per patch (glazing, issue 14); empty when nothing
-    /// transmits.
+    /// Straight-through transmittance per patch (glazing, docs/design.md §9); empty when
+    /// nothing transmits.
     trans: Vec<f32>,
     /// The factor T_c / T per patch a ray going through it carries its energy on with
     /// (`Material::tint`); empty when no glazing is tinted.
