@@ -88,6 +88,7 @@ pub fn measure_grid(
     let Some(spec) = &job.grid else {
         return Ok(None);
     };
+    solved.progress.phase("measuring the grid");
     let clock = Clock::start();
     let Some((isect, _)) = solved.isect else {
         return Err(Error::Invalid(
