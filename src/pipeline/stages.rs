@@ -1,6 +1,6 @@
 //! The stages of a solve up to its result (docs/design.md §1): load the scene, cut it into
 //! patches, build the intersector the method needs, solve. Each takes what it needs, logs what a
-//! user should hear of, and returns its value; [`super::solve_into`] calls them in order. What
+//! user should hear of, and returns its value; `solve_into` (`super`) calls them in order. What
 //! follows the solve reads it through [`Solved`].
 
 use super::{outputs, SolveJob};
