@@ -6,7 +6,7 @@ mod common;
 use common::*;
 use radiosity::mesh::Mesh;
 use radiosity::scene::{self, LoadOptions, Scene};
-use radiosity::solve::gathering::{gauss_seidel, shoot_matrix, FormFactors};
+use radiosity::solve::matrix::{gauss_seidel, shoot_matrix, FormFactors};
 use radiosity::solve::{scalar, MethodKind, RunHooks, SolveSettings, StopReason};
 use std::path::Path;
 

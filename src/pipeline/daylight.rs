@@ -1,12 +1,14 @@
-//! The daylight outputs of a solve (issue 14): the sky's description in `summary.json`, and
-//! the sensor grid — `grid.csv`, the false-colour plan `grid.png`, the grid's statistics.
+//! The daylight outputs of a solve: the sky's description in `summary.json`, and the measure
+//! stage (docs/design.md §1) — the sensor grid of `--grid`, measured on the solution, with its
+//! false-colour plan and statistics (written as `grid.csv` and `grid.png`).
 
+use super::stages::{Clock, Solved};
+use super::SolveJob;
 use crate::grid::{self, GridSpec, GridStats};
-use crate::intersect::Intersector;
-use crate::light::LightAt;
-use crate::mesh::Mesh;
-use crate::scene::Material;
+use crate::intersect::select::AnyIntersector;
 use crate::sky::{Frame, Sky, SkyKind, SkySpec, EFFICACY};
+use crate::light::LightAt;
+use crate::Error;
 use serde::Serialize;
 
 /// Rays each sensor gathers by default (`--grid-rays`): about 1 % noise per sensor.
@@ -67,6 +69,63 @@ impl SkyReport {
     }
 }
 
+/// What the measure stage made: the grid's sensors and values, its plan picture (`grid.png`)
+/// and the time measuring took (the plan's drawing left out).
+pub struct Measured {
+    pub grid: GridResult,
+    pub plan: image::RgbImage,
+    pub seconds: f64,
+    pub cpu_seconds: f64,
+}
+
+/// Measure: the sensors of `--grid` on the solution (they need the solve's intersector), the
+/// plan picture, the statistics logged; `None` without `--grid`.
+pub fn measure_grid(
+    job: &SolveJob,
+    solved: &Solved,
+    log: &mut impl FnMut(&str),
+) -> Result<Option<Measured>, Error> {
+    let Some(spec) = &job.grid else {
+        return Ok(None);
+    };
+    solved.progress.phase("measuring the grid");
+    let clock = Clock::start();
+    let Some((isect, _)) = solved.isect else {
+        return Err(Error::Invalid(
+            "--grid needs a method that casts rays (adaptive-hybrid or adaptive-rays)".into(),
+        ));
+    };
+    let frame = frame_of(job);
+    let g = measure(job, spec, solved, isect, &frame).map_err(|e| Error::Invalid(e.to_string()))?;
+    let (seconds, cpu_seconds) = (clock.seconds(), clock.cpu_seconds());
+    let plan = grid::plan_image(&g.sensors, &g.lux, &frame, spec.spacing_hint(), PLAN_WIDTH);
+    log(&format!(
+        "grid: {} sensors, mean {:.0} lux, min {:.0} lux, uniformity {:.2}, mean daylight factor {:.2} %",
+        g.stats.points, g.stats.mean_lux, g.stats.min_lux, g.stats.uniformity, g.stats.mean_df
+    ));
+    Ok(Some(Measured {
+        grid: g,
+        plan,
+        seconds,
+        cpu_seconds,
+    }))
+}
+
+/// The model's orientation: the sky's zenith and north, else the job's (checked), else the
+/// defaults (Y up, north −Z).
+pub fn frame_of(job: &SolveJob) -> Frame {
+    let (z, n) = job
+        .settings
+        .solve
+        .sky
+        .as_ref()
+        .map_or((job.zenith, job.north), |s| (s.zenith, s.north));
+    Frame::new(z, n).unwrap_or_else(|_| {
+        Frame::new(crate::sky::DEFAULT_ZENITH, crate::sky::DEFAULT_NORTH)
+            .expect("the default frame is valid")
+    })
+}
+
 /// A grid's sensors and what they measured.
 pub struct GridResult {
     pub sensors: Vec<grid::Sensor>,
@@ -75,21 +134,19 @@ pub struct GridResult {
     pub stats: GridStats,
 }
 
-/// Lux at each sensor of `spec` from the solution `b`: the gather at each point
-/// ([`LightAt::sensor_irradiance`]), luminance-weighted, × 179 lm/W; the daylight factor
-/// over `df_base` (0 without a sky).
-#[allow(clippy::too_many_arguments)]
-pub fn measure<I: Intersector>(
+/// Lux at each sensor of `spec` from the solution: the gather at each point
+/// ([`LightAt::sensor_irradiance`], `--grid-rays` each, the solve's seed),
+/// luminance-weighted, × 179 lm/W; the daylight factor over `df_base` (0 without a sky).
+fn measure(
+    job: &SolveJob,
     spec: &GridSpec,
-    mesh: &Mesh,
-    materials: &[Material],
-    isect: &I,
-    b: &[[f64; 3]],
-    sky: Option<&Sky>,
+    solved: &Solved,
+    isect: &AnyIntersector,
     frame: &Frame,
-    rays: usize,
-    seed: u64,
 ) -> Result<GridResult, grid::GridError> {
+    let (mesh, materials) = (&solved.model.mesh, &solved.model.scene.materials);
+    let (b, sky) = (&solved.sol.b, solved.sky.as_ref());
+    let (rays, seed) = (job.grid_rays, job.settings.solve.seed);
     let sensors = spec.sensors(mesh, isect, frame)?;
     let at: Vec<_> = sensors.iter().map(|s| (s.position, s.normal)).collect();
     let h = LightAt::new(mesh, materials, isect, b, sky, None).sensor_irradiance(&at, rays, seed);

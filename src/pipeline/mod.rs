@@ -1,20 +1,32 @@
-//! What `radiosity solve` and `radiosity info` do (docs/design.md §1): load → mesh → build the
-//! intersector → solve → write the patch table, the trace, the image, the JSON summary and,
-//! if asked, the saved solution. The binary only fills a [`SolveJob`].
+//! What `radiosity solve` and `radiosity info` do (docs/design.md §1). The binary only fills a
+//! [`SolveJob`]; [`run_solve`] runs its stages in order, each a function that takes what it
+//! needs and returns a value (read `solve_into` top to bottom):
+//!
+//! | stage     | function                     | returns                              |
+//! |-----------|------------------------------|--------------------------------------|
+//! | load      | [`stages::load`]             | the [`Scene`](crate::scene::Scene)   |
+//! | mesh      | [`stages::mesh`]             | the [`Model`] (scene and patches)    |
+//! | intersect | [`stages::intersect`]        | the intersector, if the method casts rays |
+//! | solve     | [`stages::solve`]            | the [`Solution`](crate::solve::Solution), read on as [`stages::Solved`] |
+//! | refine    | [`refine::refine`]           | the adaptive elements ([`refine::Refined`]) |
+//! | measure   | [`daylight::measure_grid`]   | the sensor grid ([`daylight::Measured`]) |
+//! | picture   | [`picture::picture`]         | `render.png`'s image                 |
+//! | write     | [`outputs::write`]           | the files, and the [`Summary`]       |
 //!
 //! - [`RunSettings`]: everything that shapes a solve's result, in one serialisable record. The
 //!   summary, the saved solution and the checkpoint key are derived from it.
 //! - [`hooks`]: what the run plugs into the solver (reference, per-light channels,
 //!   checkpoints, resume, Ctrl-C).
-//! - [`outputs`]: the files a solve writes.
 
 pub mod daylight;
 pub mod hooks;
 pub mod outputs;
+pub mod picture;
+pub mod refine;
+pub mod stages;
 
 use crate::export;
 use crate::intersect::select::IntersectorKind;
-use crate::intersect::Intersector;
 use crate::mesh::{self, MeshOptions};
 use crate::model::Model;
 use crate::progress::Progress;
@@ -23,9 +35,10 @@ use crate::report::{self, Summary, Timings};
 use crate::scene::{LoadOptions, SceneSource};
 use crate::settings::Invalid;
 use crate::solve::lights::GroupBy;
-use crate::solve::{MethodKind, SolveSettings, TracePoint};
+use crate::solve::{MethodKind, SolveSettings};
 use crate::Error;
 use serde::{Deserialize, Serialize};
+use stages::{Clock, Solved};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -104,7 +117,7 @@ pub struct SolveJob {
     pub resume: Option<PathBuf>,
     /// Set on Ctrl-C: stop at the next safe point.
     pub interrupt: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
-    /// Sensors to measure (`--grid`, issue 14): `grid.csv`, `grid.png`, the summary's `grid`.
+    /// Sensors to measure (`--grid`): `grid.csv`, `grid.png`, the summary's `grid`.
     pub grid: Option<crate::grid::GridSpec>,
     /// Rays each sensor gathers (`--grid-rays`).
     pub grid_rays: usize,
@@ -197,8 +210,8 @@ pub fn run_solve_with(
     result
 }
 
-/// The work of [`run_solve_with`] once the output folder is ready; every file it writes is
-/// recorded in `written` as soon as it exists.
+/// The work of [`run_solve_with`] once the output folder is ready: the stages in order
+/// (docs/design.md §1). Every file written is recorded in `written` as soon as it exists.
 fn solve_into(
     job: &SolveJob,
     progress: &Progress,
@@ -206,83 +219,52 @@ fn solve_into(
     t0: Instant,
     written: &mut Vec<PathBuf>,
 ) -> Result<Summary, Error> {
-    let s = &job.settings;
     let mut timings = Timings::default();
-    let model = load_model(job, progress, log, t0, &mut timings)?;
+    let scene = stages::load(job, progress, log)?;
+    timings.load = t0.elapsed().as_secs_f64();
 
-    // Only the methods that cast rays need an intersector (a scene builds what it needs).
-    let t = Instant::now();
-    progress.phase("building the intersectors");
-    let isect = model.intersector_for(s.solve.method, s.intersector)?;
-    timings.build = t.elapsed().as_secs_f64();
-    if let Some((isect, chosen)) = &isect {
-        log(&format!("intersector {}: {}", isect.name(), chosen.reason));
-    }
+    let clock = Clock::start();
+    let model = stages::mesh(job, scene, progress, log)?;
+    timings.mesh = clock.seconds();
+
+    let clock = Clock::start();
+    let isect = stages::intersect(job, &model, progress, log)?;
+    timings.build = clock.seconds();
 
     let hooks = hooks::build(job, &model, log)?;
-    let (t, c) = (Instant::now(), crate::report::process_cpu_seconds());
-    progress.start_solve(outputs::emitted_flux(&model));
-    let sol = model.solve(
-        isect.as_ref().map(|(i, _)| i),
-        &s.solve,
-        &hooks,
-        |p: &TracePoint| progress.solve_wave(p),
-    )?;
-    timings.solve = t.elapsed().as_secs_f64();
-    timings.cpu.solve = crate::report::process_cpu_seconds() - c;
-    log(&format!("solved: {}", Summary::stats_line(&sol.stats)));
+    let clock = Clock::start();
+    let sol = stages::solve(job, &model, isect.as_ref(), &hooks, progress, log)?;
+    (timings.solve, timings.cpu.solve) = (clock.seconds(), clock.cpu_seconds());
 
-    progress.phase("writing outputs");
-    let run = outputs::Run {
+    // From here on the solution is read, not changed; this time counts as the output's.
+    let after = Instant::now();
+    let solved = Solved {
         model: &model,
         isect: isect.as_ref(),
-        sol: &sol,
-        timings,
+        sol,
+        sky: stages::sky(job),
         t0,
         progress,
     };
-    let summary = outputs::write(job, &run, log, written)?;
+    // The elements and the gathered picture cast rays: through the solve's intersector, or
+    // one built for them (the methods that cast none).
+    let built = solved.intersector_after(job)?;
+    let rays = solved.isect.map(|(i, _)| i).or(built.as_ref());
+    let refined = refine::refine(job, &solved, rays, log);
+    let measured = daylight::measure_grid(job, &solved, log)?;
+    let picture = picture::picture(job, &solved, rays, &refined, log)?;
+    let warnings = outputs::warnings(&solved, log);
+
+    progress.phase("writing outputs");
+    let results = outputs::Results {
+        refined,
+        measured,
+        picture,
+        warnings,
+    };
+    let summary = outputs::write(job, &solved, results, timings, after, written)?;
     progress.finish();
     Ok(summary)
-}
-
-/// Loads and meshes the scene, logging its warnings and the patch size chosen.
-fn load_model(
-    job: &SolveJob,
-    progress: &Progress,
-    log: &mut impl FnMut(&str),
-    t0: Instant,
-    timings: &mut Timings,
-) -> Result<Model, Error> {
-    let s = &job.settings;
-    progress.phase("loading");
-    let scene = job.source.load(&s.load)?;
-    for w in &scene.warnings {
-        log(&format!("warning: {w}"));
-    }
-    timings.load = t0.elapsed().as_secs_f64();
-    let t = Instant::now();
-    progress.phase("meshing");
-    let model = Model::from_scene(scene, &s.mesh)?;
-    timings.mesh = t.elapsed().as_secs_f64();
-    if s.mesh.patch_size.is_none() {
-        let from = if model.scene.patch_size_hint.is_some() {
-            "the scene file's own"
-        } else {
-            "derived from the scene"
-        };
-        log(&format!(
-            "patch size {} m ({from}; --patch-size to change)",
-            model.mesh.patch_size
-        ));
-    }
-    log(&format!(
-        "{}: {} polygons, {} patches",
-        model.scene.name,
-        model.scene.polygons.len(),
-        model.mesh.patches.len()
-    ));
-    Ok(model)
 }
 
 /// `radiosity info`.

@@ -1,6 +1,6 @@
 //! Solvers: progressive refinement by shooting (Cohen et al. 1988) with the two adaptive
-//! samplers of Airey & Ouh-young (1989) and their hybrid, and the traditional gathering
-//! algorithm they are compared against.
+//! samplers of Airey & Ouh-young (1989) and their hybrid, and the traditional matrix method
+//! they are compared against (`--method gathering`).
 //!
 //! Notation follows the papers: patch `i` shoots, patch `j` receives; `b` is radiosity
 //! (W/m²), `e` emitted radiosity, `rho` reflectance; energies are fluxes Φ = B·A in f64 per RGB
@@ -19,7 +19,7 @@
 //! - [`stopping`]: Sec. 3, the stop rule (0.06 % of the mean radiosity) and the budgets;
 //! - [`estimate`]: Sec. 3's error metrics, and the solver's own estimate of its error;
 //! - [`books`]: the energy books every shooting method keeps;
-//! - [`gathering`]: the traditional algorithm (full form-factor matrix, Gauss–Seidel);
+//! - [`matrix`]: the traditional algorithm (full form-factor matrix, Gauss–Seidel);
 //! - [`final_gather`]: after shooting, the patches the shooting left noisy (the small ones)
 //!   gather their own light with rays, combined with the shooting's estimate by inverse variance;
 //! - [`checkpoint`] (the file of a run's saved state: the driver's, the books' and the
@@ -37,8 +37,8 @@ pub mod cube_shots;
 pub mod driver;
 pub mod estimate;
 pub mod final_gather;
-pub mod gathering;
 pub mod lights;
+pub mod matrix;
 pub mod passes;
 pub mod ray_shots;
 pub mod settings;
@@ -269,7 +269,7 @@ pub enum SolveError {
     #[error("the scene has {0} patches; at most {max} are supported", max = ray_shots::BACK - 1)]
     TooManyPatches(usize),
     #[error(transparent)]
-    GatherTooLarge(#[from] gathering::TooLarge),
+    MatrixTooLarge(#[from] matrix::TooLarge),
     #[error("the reference has {reference} patches but this mesh has {patches}: solve the reference with the same scene and --patch-size")]
     ReferenceMismatch { reference: usize, patches: usize },
     #[error("{0}")]
@@ -305,7 +305,7 @@ pub fn solve<I: Intersector>(
 }
 
 /// Solves by the method `cfg.method` names. `isect` is needed only by methods that cast rays
-/// ([`MethodKind::casts_rays`]): the hemi-cube methods and gathering build none.
+/// ([`MethodKind::casts_rays`]): the hemi-cube methods and the matrix method build none.
 pub fn run<I: Intersector>(
     mesh: &Mesh,
     materials: &[Material],
@@ -316,7 +316,7 @@ pub fn run<I: Intersector>(
 ) -> Result<Solution, SolveError> {
     match cfg.method {
         MethodKind::Gathering => {
-            gathering::check_size(mesh.patches.len(), cfg.gather_cap_mib)?;
+            matrix::check_size(mesh.patches.len(), cfg.gather_cap_mib)?;
             if !mesh
                 .patches
                 .iter()
@@ -332,7 +332,7 @@ pub fn run<I: Intersector>(
                     });
                 }
             }
-            Ok(gathering::gather(mesh, materials, cfg, hooks, on_trace))
+            Ok(matrix::solve(mesh, materials, cfg, hooks, on_trace))
         }
         _ => match cfg.error_target {
             Some(e) => passes::shoot_to(mesh, materials, isect, cfg, hooks, e, on_trace),

@@ -213,52 +213,6 @@ struct Base {
     gathers: final_gather::Gathers,
 }
 
-/// The combination through the final gather, when the settings ask for one: rays per patch
-/// grown by `scale` (samples so far / the first pass's) so gather and shooting stay in balance;
-/// or, with `more`, a further round pooled with the gathers `base` was made with.
-#[allow(clippy::too_many_arguments)]
-fn gathered<I: Intersector>(
-    mesh: &Mesh,
-    materials: &[Material],
-    isect: &I,
-    cfg: &SolveSettings,
-    hooks: &RunHooks,
-    pre: Solution,
-    parts: Parts,
-    scale: f64,
-    more: Option<(final_gather::Gathers, &[usize])>,
-) -> (Solution, ErrorMetrics, Base) {
-    let rays = (cfg.gather_rays_per_patch() as f64 * scale)
-        .round()
-        .min(super::settings::MAX_GATHER_RAYS as f64) as usize;
-    let shooting = final_gather::Shooting {
-        parts,
-        energy_per_ray: pre.stats.energy_per_ray,
-    };
-    let mut sol = pre.clone();
-    let sky = cfg.sky.as_ref().and_then(|s| Sky::new(s).ok());
-    let inputs = final_gather::GatherInputs {
-        mesh,
-        materials,
-        isect,
-        seed: cfg.seed,
-        rays,
-        group: hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
-        shooting: &shooting,
-        sky: sky.as_ref(),
-        reference: hooks.reference.as_deref().map(Vec::as_slice),
-    };
-    let more = more.map(|(prior, extra)| final_gather::Regather { prior, extra });
-    let gathers = final_gather::apply(&inputs, &mut sol, more, &mut |_| {});
-    let m = estimate_of(&sol);
-    let base = Base {
-        pre,
-        parts: shooting.parts,
-        gathers,
-    };
-    (sol, m, base)
-}
-
 /// The trace point after a combination (or a gather round): its rays count the final
 /// gather's too, as the driver's point after a gather does.
 fn trace_point(
@@ -304,168 +258,343 @@ pub(super) fn shoot_to<I: Intersector>(
         .map(|p| scalar(&materials[p.material as usize].emission()))
         .collect();
     let first = super::driver::shoot(mesh, materials, isect, cfg, hooks, &mut on_trace)?;
-    let r1 = samples(&first);
-    let c1 = first.stats.energy_per_ray;
-    let mut m = estimate_of(&first);
-    let mut trace = first.stats.trace.clone();
-    let mut out = first.clone();
-    let mut sols = vec![first];
-    // Later passes shoot only; the gather runs on their combination.
-    let gather = isect.filter(|_| cfg.final_gather && cfg.method.casts_rays());
-    let shoot_cfg = SolveSettings {
-        final_gather: false,
-        ..cfg.clone()
+    let inputs = Inputs {
+        mesh,
+        materials,
+        isect,
+        cfg,
+        hooks,
+        target,
+        start,
+        area,
+        emission,
     };
-    let later_hooks = RunHooks {
-        reference: hooks.reference.clone(),
-        light_groups: hooks.light_groups.clone(),
-        checkpoint: None,
-        resume: None,
-        interrupt: hooks.interrupt.clone(),
-    };
-    let mut capped = false;
-    // (samples, estimate) after the last combination, and the rate the estimate falls at.
-    let mut last = (r1, m.weighted_percent);
-    let mut p = 0.5;
-    // The first pass's gather, for further rounds; its rays, to cost a shooting pass's gather.
-    let first_gather_rays = out.stats.final_gather.map_or(0.0, |g| g.rays as f64);
-    let mut base = match (gather, sols[0].shooting.as_deref()) {
-        (Some(_), Some(shot)) if shot.gathers.is_some() => {
-            let (pre, _, parts) = combine(mesh, &area, &emission, &sols);
-            let gathers = shot.gathers.clone().expect("checked");
-            Some(Base {
-                pre,
-                parts,
-                gathers,
-            })
-        }
-        _ => None,
-    };
-    let mut regathers = 0;
-    while m.weighted_percent > target && !budget_stopped(&sols[sols.len() - 1]) {
-        let so_far: f64 = sols.iter().map(samples).sum();
-        if cfg.error_max_factor.is_some_and(|f| so_far >= f * r1) {
-            capped = true;
-            break;
-        }
-        let want = so_far * ((m.weighted_percent / (AIM * target)).powf(1.0 / p) - 1.0);
-        let mut rays = want.clamp(r1, 3.0 * so_far);
-        if let Some(f) = cfg.error_max_factor {
-            rays = rays.min((f * r1 - so_far).max(r1));
-        }
-        // A further gather round instead, when the model says it reaches the target for fewer
-        // rays than the shooting pass and its gather would cast (module notes).
-        let plan = match (gather, base.as_ref()) {
-            (Some(_), Some(b)) if regathers < MAX_REGATHERS => b.gathers.plan(
-                mesh.patches.len(),
-                AIM * target,
-                super::settings::MAX_GATHER_RAYS,
-            ),
+    let mut passes = Passes::after_first(inputs, first);
+    passes.refine(&mut on_trace)?;
+    Ok(passes.finish())
+}
+
+/// What the passes read: the scene, the first pass's settings and hooks, the target, the
+/// patches' areas and scalar emission.
+struct Inputs<'a, I> {
+    mesh: &'a Mesh,
+    materials: &'a [Material],
+    isect: Option<&'a I>,
+    cfg: &'a SolveSettings,
+    hooks: &'a RunHooks,
+    target: f64,
+    start: Instant,
+    area: Vec<f64>,
+    emission: Vec<f64>,
+}
+
+/// Where an error-target solve stands after each pass or gather round.
+struct Passes<'a, I> {
+    at: Inputs<'a, I>,
+    /// The final gather's intersector, when the settings ask for one: later passes shoot only,
+    /// the gather runs on their combination.
+    gather: Option<&'a I>,
+    /// The later passes' settings (no final gather) and hooks (no checkpoints, no resume).
+    shoot_cfg: SolveSettings,
+    later_hooks: RunHooks,
+    /// The first pass's samples and energy per ray: later passes are sized from them.
+    r1: f64,
+    c1: f64,
+    /// The first pass's gather rays, to cost a shooting pass's gather.
+    first_gather_rays: f64,
+    /// The estimate of the result so far, its trace, the result and the passes it combines.
+    m: ErrorMetrics,
+    trace: Vec<TracePoint>,
+    out: Solution,
+    sols: Vec<Solution>,
+    /// Stopped by the default target's bound.
+    capped: bool,
+    /// (samples, estimate) after the last combination, and the rate the estimate falls at.
+    last: (f64, f64),
+    p: f64,
+    /// The last final gather, for further rounds.
+    base: Option<Base>,
+    regathers: u32,
+}
+
+impl<'a, I: Intersector> Passes<'a, I> {
+    /// The state after the first pass, `first`.
+    fn after_first(at: Inputs<'a, I>, first: Solution) -> Self {
+        let cfg = at.cfg;
+        let r1 = samples(&first);
+        let c1 = first.stats.energy_per_ray;
+        let m = estimate_of(&first);
+        let trace = first.stats.trace.clone();
+        let out = first.clone();
+        let sols = vec![first];
+        let gather = at
+            .isect
+            .filter(|_| cfg.final_gather && cfg.method.casts_rays());
+        let shoot_cfg = SolveSettings {
+            final_gather: false,
+            ..cfg.clone()
+        };
+        let later_hooks = RunHooks {
+            reference: at.hooks.reference.clone(),
+            light_groups: at.hooks.light_groups.clone(),
+            checkpoint: None,
+            resume: None,
+            interrupt: at.hooks.interrupt.clone(),
+        };
+        let last = (r1, m.weighted_percent);
+        let first_gather_rays = out.stats.final_gather.map_or(0.0, |g| g.rays as f64);
+        let base = match (gather, sols[0].shooting.as_deref()) {
+            (Some(_), Some(shot)) if shot.gathers.is_some() => {
+                let (pre, _, parts) = combine(at.mesh, &at.area, &at.emission, &sols);
+                let gathers = shot.gathers.clone().expect("checked");
+                Some(Base {
+                    pre,
+                    parts,
+                    gathers,
+                })
+            }
             _ => None,
         };
-        let shoot_cost = rays + first_gather_rays * (so_far + rays) / r1;
-        if let (Some(isect), Some(plan)) = (gather, plan.filter(|pl| pl.rays < shoot_cost)) {
-            // Under --max-time, a round that does not fit in the time left is not begun.
-            let elapsed = start.elapsed().as_secs_f64();
-            let cast = trace.last().map_or(so_far, |t| t.rays as f64);
-            let want = plan.rays.ceil() as usize;
-            if super::driver::gather_rays_fitting(cfg, want, 1, cast, elapsed) != Some(want) {
-                out.stats.stop_reason = Some(StopReason::MaxTime);
+        Passes {
+            at,
+            gather,
+            shoot_cfg,
+            later_hooks,
+            r1,
+            c1,
+            first_gather_rays,
+            m,
+            trace,
+            out,
+            sols,
+            capped: false,
+            last,
+            p: 0.5,
+            base,
+            regathers: 0,
+        }
+    }
+
+    /// Further passes or gather rounds until the estimate reaches the target or a budget, or
+    /// the default target's bound, stops them.
+    fn refine(&mut self, on_trace: &mut impl FnMut(&TracePoint)) -> Result<(), SolveError> {
+        let (cfg, target, r1) = (self.at.cfg, self.at.target, self.r1);
+        while self.m.weighted_percent > target && !budget_stopped(&self.sols[self.sols.len() - 1]) {
+            let so_far: f64 = self.sols.iter().map(samples).sum();
+            if cfg.error_max_factor.is_some_and(|f| so_far >= f * r1) {
+                self.capped = true;
                 break;
             }
-            let b = base.take().expect("planned from it");
-            let (sol, em, nb) = gathered(
-                mesh,
-                materials,
-                isect,
-                cfg,
-                hooks,
-                b.pre,
-                b.parts,
-                1.0,
-                Some((b.gathers, &plan.extra)),
-            );
-            regathers += 1;
-            (out, m) = (sol, em);
-            base = Some(nb);
-            let point = trace_point(&out, m, start, hooks, &area);
-            on_trace(&point);
-            trace.push(point);
-            last = (so_far, m.weighted_percent);
-            continue;
+            let want =
+                so_far * ((self.m.weighted_percent / (AIM * target)).powf(1.0 / self.p) - 1.0);
+            let mut rays = want.clamp(r1, 3.0 * so_far);
+            if let Some(f) = cfg.error_max_factor {
+                rays = rays.min((f * r1 - so_far).max(r1));
+            }
+            // A further gather round instead, when the model says it reaches the target for
+            // fewer rays than the shooting pass and its gather would cast (module notes).
+            let plan = match (self.gather, self.base.as_ref()) {
+                (Some(_), Some(b)) if self.regathers < MAX_REGATHERS => b.gathers.plan(
+                    self.at.mesh.patches.len(),
+                    AIM * target,
+                    super::settings::MAX_GATHER_RAYS,
+                ),
+                _ => None,
+            };
+            let shoot_cost = rays + self.first_gather_rays * (so_far + rays) / r1;
+            if let (Some(isect), Some(plan)) = (self.gather, plan.filter(|pl| pl.rays < shoot_cost))
+            {
+                if !self.regather(isect, &plan, so_far, on_trace) {
+                    break;
+                }
+                continue;
+            }
+            if !self.further_pass(rays, so_far, on_trace)? {
+                break;
+            }
         }
-        let elapsed = start.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// A further gather round pooled with the last gather, in place of a pass. False (and the
+    /// solve stopped by time) when, under `--max-time`, the round does not fit in the time left.
+    fn regather(
+        &mut self,
+        isect: &I,
+        plan: &final_gather::RegatherPlan,
+        so_far: f64,
+        on_trace: &mut impl FnMut(&TracePoint),
+    ) -> bool {
+        let elapsed = self.at.start.elapsed().as_secs_f64();
+        let cast = self.trace.last().map_or(so_far, |t| t.rays as f64);
+        let want = plan.rays.ceil() as usize;
+        if super::driver::gather_rays_fitting(self.at.cfg, want, 1, cast, elapsed) != Some(want) {
+            self.out.stats.stop_reason = Some(StopReason::MaxTime);
+            return false;
+        }
+        let b = self.base.take().expect("planned from it");
+        let more = Some((b.gathers, plan.extra.as_slice()));
+        let (sol, em, nb) = self.gathered(isect, b.pre, b.parts, 1.0, more);
+        self.regathers += 1;
+        (self.out, self.m) = (sol, em);
+        self.base = Some(nb);
+        self.record(on_trace);
+        self.last = (so_far, self.m.weighted_percent);
+        true
+    }
+
+    /// A further independent pass of about `rays` samples, combined with the others (and
+    /// gathered on). False when a budget leaves no room for it or cuts it short: it is left out.
+    fn further_pass(
+        &mut self,
+        rays: f64,
+        so_far: f64,
+        on_trace: &mut impl FnMut(&TracePoint),
+    ) -> Result<bool, SolveError> {
+        let cfg = self.at.cfg;
+        let elapsed = self.at.start.elapsed().as_secs_f64();
         let used = so_far as u64;
         let next = SolveSettings {
             seed: crate::random::mix(
-                cfg.seed ^ (sols.len() as u64).wrapping_mul(0x2545_F491_4F6C_DD1D),
+                cfg.seed ^ (self.sols.len() as u64).wrapping_mul(0x2545_F491_4F6C_DD1D),
             ),
-            energy_per_ray: Some(c1 * r1 / rays),
+            energy_per_ray: Some(self.c1 * self.r1 / rays),
             max_time: match cfg.max_time {
-                Some(t) if elapsed >= t => break,
+                Some(t) if elapsed >= t => return Ok(false),
                 Some(t) => Some(t - elapsed),
                 None => None,
             },
             max_rays: match cfg.max_rays {
-                Some(r) if used >= r => break,
+                Some(r) if used >= r => return Ok(false),
                 Some(r) => Some(r - used),
                 None => None,
             },
-            ..shoot_cfg.clone()
+            ..self.shoot_cfg.clone()
         };
-        let sol = super::driver::shoot(mesh, materials, isect, &next, &later_hooks, |_| {})?;
+        let (mesh, materials) = (self.at.mesh, self.at.materials);
+        let sol = super::driver::shoot(
+            mesh,
+            materials,
+            self.at.isect,
+            &next,
+            &self.later_hooks,
+            |_| {},
+        )?;
         if budget_stopped(&sol) {
             // Cut short: left out, the result stays as it was (module notes).
-            out.stats.stop_reason = sol.stats.stop_reason;
-            break;
+            self.out.stats.stop_reason = sol.stats.stop_reason;
+            return Ok(false);
         }
-        // Its gather, under --max-time cut to the rays that fit; when not even the fewest do,
-        // the pass is left out as a pass cut short is.
-        let mut scale = (so_far + samples(&sol)) / r1;
-        if gather.is_some() {
-            let wanted = (cfg.gather_rays_per_patch() as f64 * scale).round() as usize;
-            let elapsed = start.elapsed().as_secs_f64();
-            let cast = so_far + samples(&sol);
-            match super::driver::gather_rays_fitting(cfg, wanted, mesh.patches.len(), cast, elapsed)
-            {
-                Some(r) => scale = scale * r as f64 / wanted.max(1) as f64,
-                None => {
-                    out.stats.stop_reason = Some(StopReason::MaxTime);
-                    break;
-                }
-            }
-        }
-        sols.push(sol);
-        let combined = combine(mesh, &area, &emission, &sols);
-        (out, m) = match gather {
+        let Some(scale) = self.gather_scale(so_far, &sol) else {
+            self.out.stats.stop_reason = Some(StopReason::MaxTime);
+            return Ok(false);
+        };
+        self.sols.push(sol);
+        let combined = combine(mesh, &self.at.area, &self.at.emission, &self.sols);
+        (self.out, self.m) = match self.gather {
             Some(isect) => {
                 let (pre, _, parts) = combined;
-                let (sol, em, b) =
-                    gathered(mesh, materials, isect, cfg, hooks, pre, parts, scale, None);
-                base = Some(b);
+                let (sol, em, b) = self.gathered(isect, pre, parts, scale, None);
+                self.base = Some(b);
                 (sol, em)
             }
             None => (combined.0, combined.1),
         };
-        let point = trace_point(&out, m, start, hooks, &area);
-        on_trace(&point);
-        trace.push(point);
-        let now = (sols.iter().map(samples).sum::<f64>(), m.weighted_percent);
-        p = rate(last, now);
-        last = now;
+        self.record(on_trace);
+        let now = (
+            self.sols.iter().map(samples).sum::<f64>(),
+            self.m.weighted_percent,
+        );
+        self.p = rate(self.last, now);
+        self.last = now;
+        Ok(true)
     }
-    out.shooting = None;
-    out.stats.seconds = start.elapsed().as_secs_f64();
-    out.stats.trace = trace;
-    out.stats.error_target = Some(ErrorTarget {
-        target,
-        estimate: m.weighted_percent,
-        reached: m.weighted_percent <= target,
-        passes: sols.len() as u32,
-        regathers,
-        gave_up: capped,
-    });
-    Ok(out)
+
+    /// How much the gather after pass `sol` grows its rays per patch (samples so far / the
+    /// first pass's), under `--max-time` cut to the rays that fit; `None` when not even the
+    /// fewest do (the pass is then left out, as a pass cut short is).
+    fn gather_scale(&self, so_far: f64, sol: &Solution) -> Option<f64> {
+        let cfg = self.at.cfg;
+        let mut scale = (so_far + samples(sol)) / self.r1;
+        if self.gather.is_some() {
+            let wanted = (cfg.gather_rays_per_patch() as f64 * scale).round() as usize;
+            let elapsed = self.at.start.elapsed().as_secs_f64();
+            let cast = so_far + samples(sol);
+            let np = self.at.mesh.patches.len();
+            let r = super::driver::gather_rays_fitting(cfg, wanted, np, cast, elapsed)?;
+            scale = scale * r as f64 / wanted.max(1) as f64;
+        }
+        Some(scale)
+    }
+
+    /// The combination through the final gather: rays per patch grown by `scale` (samples so
+    /// far / the first pass's) so gather and shooting stay in balance; or, with `more`, a
+    /// further round pooled with the gathers the last one was made with.
+    fn gathered(
+        &self,
+        isect: &I,
+        pre: Solution,
+        parts: Parts,
+        scale: f64,
+        more: Option<(final_gather::Gathers, &[usize])>,
+    ) -> (Solution, ErrorMetrics, Base) {
+        let (cfg, hooks) = (self.at.cfg, self.at.hooks);
+        let rays = (cfg.gather_rays_per_patch() as f64 * scale)
+            .round()
+            .min(super::settings::MAX_GATHER_RAYS as f64) as usize;
+        let shooting = final_gather::Shooting {
+            parts,
+            energy_per_ray: pre.stats.energy_per_ray,
+        };
+        let mut sol = pre.clone();
+        let sky = cfg.sky.as_ref().and_then(|s| Sky::new(s).ok());
+        let inputs = final_gather::GatherInputs {
+            mesh: self.at.mesh,
+            materials: self.at.materials,
+            isect,
+            seed: cfg.seed,
+            rays,
+            group: hooks.light_groups.as_deref().map(|g| g.of_patch.as_slice()),
+            shooting: &shooting,
+            sky: sky.as_ref(),
+            reference: hooks.reference.as_deref().map(Vec::as_slice),
+        };
+        let more = more.map(|(prior, extra)| final_gather::Regather { prior, extra });
+        let gathers = final_gather::apply(&inputs, &mut sol, more, &mut |_| {});
+        let m = estimate_of(&sol);
+        let base = Base {
+            pre,
+            parts: shooting.parts,
+            gathers,
+        };
+        (sol, m, base)
+    }
+
+    /// Records the trace point of the result as it now stands.
+    fn record(&mut self, on_trace: &mut impl FnMut(&TracePoint)) {
+        let at = &self.at;
+        let point = trace_point(&self.out, self.m, at.start, at.hooks, &at.area);
+        on_trace(&point);
+        self.trace.push(point);
+    }
+
+    /// The result: the last combination, with the whole trace and what the target did.
+    fn finish(self) -> Solution {
+        let (m, target) = (self.m, self.at.target);
+        let mut out = self.out;
+        out.shooting = None;
+        out.stats.seconds = self.at.start.elapsed().as_secs_f64();
+        out.stats.trace = self.trace;
+        out.stats.error_target = Some(ErrorTarget {
+            target,
+            estimate: m.weighted_percent,
+            reached: m.weighted_percent <= target,
+            passes: self.sols.len() as u32,
+            regathers: self.regathers,
+            gave_up: self.capped,
+        });
+        out
+    }
 }
 
 #[cfg(test)]

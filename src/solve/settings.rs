@@ -58,8 +58,8 @@ pub enum MethodKind {
     /// is cheaper (Sec. 4: curves C then D). The default.
     #[default]
     AdaptiveHybrid,
-    /// The traditional algorithm: full form-factor matrix by the uniform hemi-cube, then
-    /// Gauss–Seidel.
+    /// The matrix method ([`super::matrix`]), the traditional algorithm: full form-factor
+    /// matrix by the uniform hemi-cube, then Gauss–Seidel. Named `gathering` on the command line.
     Gathering,
 }
 

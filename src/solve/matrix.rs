@@ -1,10 +1,11 @@
 //! The traditional radiosity algorithm (Cohen & Greenberg 1985), the baseline the paper beats:
 //! compute the full form-factor matrix F with a uniform hemi-cube from every patch, then solve
-//! B = E + ρ·F·B by Gauss–Seidel iteration (gathering).
+//! B = E + ρ·F·B by Gauss–Seidel iteration: the matrix method (`--method gathering` on the
+//! command line and in `summary.json`).
 //!
-//! Memory is quadratic (n² form factors, f32), so [`gather`] refuses scenes whose matrix would
+//! Memory is quadratic (n² form factors, f32), so [`solve`] refuses scenes whose matrix would
 //! exceed a cap, naming the patch count and the memory it would need. [`FormFactors`] is also
-//! what lets a test feed the *same* form factors to gathering and to shooting
+//! what lets a test feed the *same* form factors to the matrix method and to shooting
 //! ([`shoot_matrix`]) and check that both reach the same solution.
 
 use super::{scalar, EnergyBalance, Solution, SolveStats, StopReason, TracePoint};
@@ -61,7 +62,7 @@ impl FormFactors {
     }
 }
 
-/// Why gathering was refused.
+/// Why the matrix method was refused (`--method gathering`).
 #[derive(Debug, thiserror::Error)]
 #[error("gathering needs the full form-factor matrix: {patches} patches need {need_mib} MiB, over the cap of {cap_mib} MiB (--gather-cap-mib); use a shooting method, or a larger patch size")]
 pub struct TooLarge {
@@ -116,15 +117,15 @@ pub fn gauss_seidel_with(
         sweeps += 1;
         for i in 0..n {
             let row = ff.row(i);
-            let mut gathered = [0.0f64; 3];
+            let mut received = [0.0f64; 3];
             for (j, &fij) in row.iter().enumerate() {
                 if fij != 0.0 {
                     for c in 0..3 {
-                        gathered[c] += fij as f64 * b[j][c];
+                        received[c] += fij as f64 * b[j][c];
                     }
                 }
             }
-            let new = [0, 1, 2].map(|c| e[i][c] + rho[i][c] * gathered[c]);
+            let new = [0, 1, 2].map(|c| e[i][c] + rho[i][c] * received[c]);
             change[i] = scalar(&[0, 1, 2].map(|c| (new[c] - b[i][c]).abs()));
             b[i] = new;
         }
@@ -138,7 +139,7 @@ pub fn gauss_seidel_with(
     (b, sweeps)
 }
 
-/// Gathering's own error estimate per patch (see [`super::estimate`]), from three parts:
+/// The matrix method's own error estimate per patch (see [`super::estimate`]), from three parts:
 /// - the form factors' error, seen through reciprocity: row i (i's hemi-cube) and column i
 ///   (A_j·F_ji/A_i, the other hemi-cubes) estimate the same exchange independently, so half
 ///   their difference, ρ_i·|Σ_j (F_ij − A_j F_ji/A_i)·B_j| / √2, measures what row i gets wrong
@@ -148,8 +149,7 @@ pub fn gauss_seidel_with(
 /// - the convergence still to come: the last sweep's change times q/(1 − q), q the sweep to
 ///   sweep ratio of the largest change (for the first sweep, the second sweep's change over
 ///   1 − q); before the first sweep, all of the reflected light.
-#[allow(clippy::too_many_arguments)]
-fn gathering_estimate(
+fn matrix_estimate(
     ff: &FormFactors,
     area: &[f64],
     rho_s: &[f64],
@@ -193,7 +193,7 @@ fn gathering_estimate(
 }
 
 /// Progressive shooting (Southwell iteration, as in Cohen et al. 1988) over the same linear
-/// system B = E + ρ·F·B that [`gauss_seidel`] solves: the test twin of gathering. Shoots the
+/// system B = E + ρ·F·B that [`gauss_seidel`] solves: the test twin of the matrix method. Shoots the
 /// patch with the most unshot flux ΔB_i·A_i until max unshot radiosity is below `stop_fraction`
 /// of the mean; patch j gains ρ_j·F_ji·ΔB_i (column i of F). Hemi-cube form factors are
 /// reciprocal (A_i·F_ij = A_j·F_ji) only approximately, so shooting along row i instead, as a
@@ -234,9 +234,9 @@ pub fn shoot_matrix(
 }
 
 /// The traditional method end to end: matrix by the uniform `n_cube` hemi-cube, then
-/// Gauss–Seidel. The energy books are computed from the answer (gathering moves no energy
+/// Gauss–Seidel. The energy books are computed from the answer (the matrix method moves no energy
 /// explicitly, so they close only as well as the hemi-cube's form factors are consistent).
-pub fn gather(
+pub fn solve(
     mesh: &Mesh,
     materials: &[Material],
     cfg: &super::SolveSettings,
@@ -271,7 +271,7 @@ pub fn gather(
     let e_s: Vec<f64> = e.iter().map(scalar).collect();
     let mut point = |time_s: f64, b: &[[f64; 3]], conv: Option<(&[f64], f64)>| {
         let bs = b_now(b);
-        let err = gathering_estimate(&ff, &area, &rho_s, &bs, &e_s, cells, conv);
+        let err = matrix_estimate(&ff, &area, &rho_s, &bs, &e_s, cells, conv);
         // The estimate of the true B: B plus the light still to come.
         let b_est: Vec<f64> = match conv {
             Some((ch, factor)) => bs.iter().zip(ch).map(|(b, c)| b + c * factor).collect(),
@@ -295,7 +295,7 @@ pub fn gather(
     };
     // Before any sweep the whole reflected light is missing: count it as the error.
     point(matrix_s, &e, None);
-    // Gathering has no useful answer before it converges (the paper's point), so its trace is
+    // The matrix method has no useful answer before it converges (the paper's point), so its trace is
     // written when it has: the convergence error of sweep k is then known, |B_k − B_last|, plus
     // the last sweep's own geometric tail, Δ_last·q/(1 − q) with q the ratio of the last two
     // sweeps' largest changes.
@@ -452,11 +452,11 @@ mod tests {
         (FormFactors { n, f }, e, rho, area)
     }
 
-    /// Fed the same form factors, gathering (Gauss–Seidel) and shooting reach the same B:
+    /// Fed the same form factors, the matrix method (Gauss–Seidel) and shooting reach the same B:
     /// both converge to the unique solution of B = E + ρFB; with the criterion at 1e-9 of the
     /// mean, they differ by far less than 1e-6 relative.
     #[test]
-    fn gathering_and_shooting_agree_on_the_same_matrix() {
+    fn gauss_seidel_and_shooting_agree_on_the_same_matrix() {
         let (ff, e, rho, area) = random_system(60, 3);
         let (bg, sweeps) = gauss_seidel(&ff, &e, &rho, &area, 1e-10, 10_000);
         assert!(sweeps > 3 && sweeps < 10_000);

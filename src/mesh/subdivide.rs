@@ -1,0 +1,181 @@
+//! Subdivision of a planar convex piece into patches no longer than the patch size: quads into
+//! an m×n bilinear grid of sub-quads, triangles into k² similar sub-triangles, convex n-gons
+//! whole when small enough and fanned from their centroid otherwise. Each patch gets its area,
+//! area centroid, normal and class.
+
+use super::classify::classify;
+use super::{newell, Mesh, Patch, Side};
+use glam::Vec3;
+use std::collections::HashMap;
+
+/// Accumulates patches and welds their vertices by (position, facing).
+pub(super) struct Builder {
+    pub(super) mesh: Mesh,
+    size: f32,
+    /// Weld grid cell size: positions closer than this (and facing the same way) are one vertex.
+    pub(super) quantum: f32,
+    pub(super) weld: HashMap<([i64; 3], [i32; 3], u32), u32>,
+}
+
+impl Builder {
+    pub(super) fn new(size: f32, diagonal: f32) -> Self {
+        Builder {
+            mesh: Mesh {
+                patch_size: size,
+                ..Mesh::default()
+            },
+            size,
+            quantum: diagonal * 1e-6,
+            weld: HashMap::new(),
+        }
+    }
+
+    /// Cuts one planar convex polygon into patches no longer than the patch size.
+    pub(super) fn add_polygon(&mut self, pts: &[Vec3], material: u32, polygon: u32) {
+        let n = newell(pts).normalize_or_zero();
+        if n == Vec3::ZERO {
+            return;
+        }
+        let s = self.size;
+        let div = |len: f32| ((len / s).ceil() as usize).max(1);
+        match pts.len() {
+            3 => {
+                let longest = (0..3)
+                    .map(|k| (pts[(k + 1) % 3] - pts[k]).length())
+                    .fold(0.0, f32::max);
+                let k = div(longest);
+                self.add_subdivided_triangle(pts, k, n, material, polygon);
+            }
+            4 => {
+                let along_u = (pts[1] - pts[0]).length().max((pts[2] - pts[3]).length());
+                let along_v = (pts[3] - pts[0]).length().max((pts[2] - pts[1]).length());
+                let (m, k) = (div(along_u), div(along_v));
+                // Bilinear grid: iso-u and iso-v lines of a planar convex quad are straight,
+                // so every cell is a planar convex quad with edges ≤ the patch size.
+                let at = |i: usize, j: usize| {
+                    let (u, v) = (i as f32 / m as f32, j as f32 / k as f32);
+                    let a = pts[0].lerp(pts[1], u);
+                    let b = pts[3].lerp(pts[2], u);
+                    a.lerp(b, v)
+                };
+                let grid: Vec<u32> = (0..=k)
+                    .flat_map(|j| (0..=m).map(move |i| (i, j)))
+                    .map(|(i, j)| at(i, j))
+                    .collect::<Vec<_>>()
+                    .into_iter()
+                    .map(|p| self.vertex(p, n, material))
+                    .collect();
+                let g = |i: usize, j: usize| grid[j * (m + 1) + i];
+                for j in 0..k {
+                    for i in 0..m {
+                        let ids = [g(i, j), g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)];
+                        self.push_patch(&ids, n, material, polygon);
+                    }
+                }
+            }
+            count => {
+                let longest = (0..count)
+                    .map(|k| (pts[(k + 1) % count] - pts[k]).length())
+                    .fold(0.0, f32::max);
+                let c = pts.iter().copied().sum::<Vec3>() / count as f32;
+                let radius = pts.iter().map(|p| (*p - c).length()).fold(0.0, f32::max);
+                if longest <= s && radius <= s {
+                    let ids: Vec<u32> = pts.iter().map(|&p| self.vertex(p, n, material)).collect();
+                    self.push_patch(&ids, n, material, polygon);
+                } else {
+                    // A large n-gon: fan from its centroid, then cut each triangle.
+                    for e in 0..count {
+                        let tri = [c, pts[e], pts[(e + 1) % count]];
+                        let longest = (0..3)
+                            .map(|q| (tri[(q + 1) % 3] - tri[q]).length())
+                            .fold(0.0, f32::max);
+                        self.add_subdivided_triangle(&tri, div(longest), n, material, polygon);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Cuts a triangle into k² similar triangles on a barycentric grid (edges = original / k).
+    fn add_subdivided_triangle(
+        &mut self,
+        t: &[Vec3],
+        k: usize,
+        n: Vec3,
+        material: u32,
+        polygon: u32,
+    ) {
+        let at = |i: usize, j: usize| {
+            // Point i steps along t0→t1 and j steps along t0→t2.
+            t[0] + (t[1] - t[0]) * (i as f32 / k as f32) + (t[2] - t[0]) * (j as f32 / k as f32)
+        };
+        let mut row_start = Vec::with_capacity(k + 1);
+        let mut ids = Vec::new();
+        for j in 0..=k {
+            row_start.push(ids.len());
+            for i in 0..=(k - j) {
+                let p = if i + j == k && j == 0 {
+                    t[1]
+                } else if i == 0 && j == k {
+                    t[2]
+                } else {
+                    at(i, j)
+                };
+                ids.push(self.vertex(p, n, material));
+            }
+        }
+        let g = |i: usize, j: usize| ids[row_start[j] + i];
+        for j in 0..k {
+            for i in 0..(k - j) {
+                self.push_patch(&[g(i, j), g(i + 1, j), g(i, j + 1)], n, material, polygon);
+                if i + j + 1 < k {
+                    self.push_patch(
+                        &[g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)],
+                        n,
+                        material,
+                        polygon,
+                    );
+                }
+            }
+        }
+    }
+
+    fn push_patch(&mut self, ids: &[u32], n: Vec3, material: u32, polygon: u32) {
+        let pts: Vec<Vec3> = ids
+            .iter()
+            .map(|&i| self.mesh.vertices[i as usize])
+            .collect();
+        let nn = newell(&pts);
+        let area = nn.length() as f64 * 0.5;
+        if area <= 0.0 {
+            return;
+        }
+        // The centroid of the polygon's area (not of its vertices), from its fan triangles.
+        let mut c = glam::DVec3::ZERO;
+        let mut a_sum = 0.0;
+        for k in 1..pts.len() - 1 {
+            let (a, b, d) = (pts[0].as_dvec3(), pts[k].as_dvec3(), pts[k + 1].as_dvec3());
+            let ak = (b - a).cross(d - a).length() * 0.5;
+            c += (a + b + d) / 3.0 * ak;
+            a_sum += ak;
+        }
+        let centre = if a_sum > 0.0 {
+            (c / a_sum).as_vec3()
+        } else {
+            pts[0]
+        };
+        let first = self.mesh.patch_vertices.len() as u32;
+        self.mesh.patch_vertices.extend_from_slice(ids);
+        self.mesh.patches.push(Patch {
+            first,
+            count: ids.len() as u32,
+            material,
+            polygon,
+            area,
+            centre,
+            normal: n,
+            class: classify(&pts, n),
+            side: Side::One,
+        });
+    }
+}
