@@ -166,7 +166,7 @@ pub fn write(
         .sky
         .as_ref()
         .zip(solved.sky.as_ref())
-        .map(|(spec, sky)| super::daylight::SkyReport::new(spec, sky));
+        .map(|(spec, sky)| crate::report::sky::SkyReport::new(spec, sky));
     write_atomic(&json, |w| {
         serde_json::to_writer_pretty(&mut *w, &summary).map_err(std::io::Error::other)?;
         writeln!(w)

@@ -3,6 +3,7 @@
 //! (compare's error against time, decay and cost per shot; the sweep's growth).
 
 pub mod plot;
+pub mod sky;
 pub mod trace;
 
 use crate::intersect::select;
@@ -357,7 +358,7 @@ pub struct Summary {
     pub trace: Vec<TracePoint>,
     /// The sky (issue 14), when the solve had one.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub sky: Option<crate::pipeline::daylight::SkyReport>,
+    pub sky: Option<sky::SkyReport>,
     /// The sensor grid's statistics (`--grid`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grid: Option<crate::grid::GridStats>,
