@@ -5,7 +5,7 @@ use crate::grid::{self, GridSpec, GridStats};
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
-use crate::sky::{Frame, Sky, SkyKind, SkySpec, EFFICACY};
+use crate::sky::{Compass, Sky, SkyKind, SkySpec, EFFICACY};
 use crate::solve::final_gather;
 use serde::Serialize;
 
@@ -86,7 +86,7 @@ pub fn measure<I: Intersector>(
     isect: &I,
     b: &[[f64; 3]],
     sky: Option<&Sky>,
-    frame: &Frame,
+    frame: &Compass,
     rays: usize,
     seed: u64,
 ) -> Result<GridResult, grid::GridError> {

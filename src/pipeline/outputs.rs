@@ -350,7 +350,7 @@ fn write_png(path: &std::path::Path, img: &image::RgbImage) -> Result<(), Error>
 }
 
 /// The model's orientation: the sky's zenith and north, else the defaults (Y up, north −Z).
-fn frame_of(job: &SolveJob) -> crate::sky::Frame {
+fn frame_of(job: &SolveJob) -> crate::sky::Compass {
     // The sky's own frame when there is one (the same flags), else the job's (checked).
     let (z, n) = job
         .settings
@@ -358,10 +358,7 @@ fn frame_of(job: &SolveJob) -> crate::sky::Frame {
         .sky
         .as_ref()
         .map_or((job.zenith, job.north), |s| (s.zenith, s.north));
-    crate::sky::Frame::new(z, n).unwrap_or_else(|_| {
-        crate::sky::Frame::new(crate::sky::DEFAULT_ZENITH, crate::sky::DEFAULT_NORTH)
-            .expect("the default frame is valid")
-    })
+    crate::sky::Compass::new(z, n).unwrap_or_default()
 }
 
 /// The grid's sensors measured on the solution (they need the rays' intersector).

@@ -24,15 +24,15 @@ pub enum GenerateCommand {
         /// The OBJ file to write.
         #[arg(long)]
         out: PathBuf,
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = BuildingOptions::default().floors)]
         floors: u32,
         /// Rooms per floor.
-        #[arg(long, default_value_t = 8)]
+        #[arg(long, default_value_t = BuildingOptions::default().rooms_per_floor)]
         rooms: u32,
         /// Aim at about this many patches (overrides --floors and --rooms).
         #[arg(long)]
         patches: Option<usize>,
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = BuildingOptions::default().seed)]
         seed: u64,
     },
 }
