@@ -9,7 +9,7 @@ use radiosity::intersect::brute::BruteForce;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{Mesh, MeshOptions};
 use radiosity::scene::Scene;
-use radiosity::sky::Frame;
+use radiosity::sky::Compass;
 
 mod common;
 
@@ -197,7 +197,7 @@ fn grid_follows_the_frame_north_and_zenith() {
     // North +X with Y up: east = north × up = +Z. The same 80 points, in rows along z.
     let m = mesh(&room(3.0), false);
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
-    let frame = Frame::new(Vec3::Y, Vec3::X).unwrap();
+    let frame = Compass::new(Vec3::Y, Vec3::X).unwrap();
     let got = grid::work_plane(&m, &embree, &frame, 0.8, 0.5).unwrap();
     let key = |s: &Sensor| (s.position.x.to_bits(), s.position.z.to_bits());
     let mut sorted = got.clone();
@@ -216,7 +216,7 @@ fn grid_follows_the_frame_north_and_zenith() {
     }
     let m = mesh(&z_up, false);
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
-    let frame = Frame::new(Vec3::Z, Vec3::Y).unwrap();
+    let frame = Compass::new(Vec3::Z, Vec3::Y).unwrap();
     let got = grid::work_plane(&m, &embree, &frame, 0.8, 0.5).unwrap();
     let want: Vec<Sensor> = lattice(0.8)
         .iter()

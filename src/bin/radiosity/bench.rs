@@ -1,6 +1,6 @@
 //! Benchmarks and cross-checks: `radiosity bench …`, `radiosity crosscheck`, `radiosity sweep`.
 
-use crate::args::{parse_sizes, source, SceneArgs, Sizes, SolverArgs};
+use super::args::{parse_sizes, source, SceneArgs, Sizes, SolverArgs};
 use crate::{out, outln};
 use clap::{Args, Subcommand};
 use radiosity::bench::elements::{

@@ -1,6 +1,6 @@
 //! `radiosity reference` and `radiosity compare`: the paper's error and speed analyses.
 
-use crate::args::{source, SamplingArgs, SceneArgs};
+use super::args::{source, SamplingArgs, SceneArgs};
 use crate::out;
 use clap::Args;
 use radiosity::compare::{self, CompareJob, ReferenceJob};

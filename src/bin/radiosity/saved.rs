@@ -1,6 +1,6 @@
 //! The commands that act on a saved solution (`solve --save`): `render`, `export`, `relight`.
 
-use crate::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs};
+use super::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs};
 use crate::outln;
 use clap::Args;
 use radiosity::progress::Progress;

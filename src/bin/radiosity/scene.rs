@@ -1,6 +1,6 @@
 //! `radiosity info` (describe a scene) and `radiosity generate` (write a model).
 
-use crate::args::{source, SceneArgs};
+use super::args::{source, SceneArgs};
 use crate::{out, outln};
 use clap::{Args, Subcommand};
 use radiosity::generate::{self, BuildingOptions, BUILDING_PATCH_SIZE};

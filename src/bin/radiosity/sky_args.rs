@@ -3,7 +3,7 @@
 //! ([`SkySettings::check`]) before any model is read, so a bad value is one line naming the
 //! flag and exit code 2.
 
-use crate::args::{parse_floats, parse_vec3, Xyz};
+use super::args::{parse_floats, parse_vec3, Xyz};
 use clap::Args;
 use glam::Vec3;
 use radiosity::sky::{
@@ -20,10 +20,15 @@ pub struct SkyArgs {
     pub sky: Option<SkyKind>,
     /// The sky's unobstructed horizontal illuminance without the sun, lux [default: 10000 for
     /// overcast and uniform; gensky's value from the sun's altitude for clear].
-    #[arg(long, value_name = "LUX")]
+    #[arg(long, value_name = "LUX", allow_negative_numbers = true)]
     pub sky_illuminance: Option<f64>,
     /// The sky's zenith luminance, cd/m² (gensky -b × 179), instead of --sky-illuminance.
-    #[arg(long, value_name = "CD_M2", conflicts_with = "sky_illuminance")]
+    #[arg(
+        long,
+        value_name = "CD_M2",
+        conflicts_with = "sky_illuminance",
+        allow_negative_numbers = true
+    )]
     pub zenith_luminance: Option<f64>,
     /// A sun: ALT,AZI in degrees (azimuth west of south, as gensky -ang), or a local time
     /// such as 2026-06-21T12:00+02:00 (with --site), or off.
@@ -33,10 +38,10 @@ pub struct SkyArgs {
     #[arg(long, value_name = "LAT,LON", value_parser = parse_pair, allow_hyphen_values = true)]
     pub site: Option<(f64, f64)>,
     /// The sun's direct normal illuminance, lux [default: gensky's clear-sky sun].
-    #[arg(long, value_name = "LUX")]
+    #[arg(long, value_name = "LUX", allow_negative_numbers = true)]
     pub sun_illuminance: Option<f64>,
     /// Reflectance of the ground outside the model, which glows below the horizon.
-    #[arg(long, default_value_t = DEFAULT_GROUND_REFLECTANCE, value_name = "RHO")]
+    #[arg(long, default_value_t = DEFAULT_GROUND_REFLECTANCE, value_name = "RHO", allow_negative_numbers = true)]
     pub ground_reflectance: f64,
     /// The model's up direction X,Y,Z.
     #[arg(long, value_parser = Xyz::parse, allow_hyphen_values = true, default_value_t = Xyz(DEFAULT_ZENITH))]

@@ -1,8 +1,9 @@
 //! `radiosity solve`.
 
-use crate::args::{source, SceneArgs, ShadingArgs, SolverArgs, ViewArgs};
-use crate::sky_args::SkyArgs;
-use crate::{interrupt_flag, outln};
+use super::args::{source, SceneArgs, ShadingArgs, SolverArgs, ViewArgs};
+use super::interrupt_flag;
+use super::sky_args::SkyArgs;
+use crate::outln;
 use clap::Args;
 use radiosity::elements;
 use radiosity::pipeline::{self, RunSettings, SolveJob, DEFAULT_CHECKPOINT_EVERY};
