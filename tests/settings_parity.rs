@@ -359,7 +359,7 @@ const SHAPING: &[Shaping] = &[
     shaping("element-threshold", &["--element-threshold", "0.5"], &[]),
     shaping("element-min-size", &["--element-min-size", "0.01"], &[]),
     shaping("element-rays", &["--element-rays", "16"], &[]),
-    shaping("element-max", &["--element-max", "8"], &[]),
+    shaping("element-max", &["--element-max", "16"], &[]),
     shaping("element-test", &["--element-test", "corners"], &[]),
     shaping("per-light", &["--per-light"], &[]),
     shaping(
