@@ -73,7 +73,7 @@ fn mesh(s: &Scene, two_sided: bool) -> Mesh {
 
 /// The work plane by Embree, checked against the brute-force oracle (Y up, north −Z).
 fn plane(m: &Mesh, height: f32, spacing: f32) -> Result<Vec<Sensor>, GridError> {
-    let frame = Frame::default();
+    let frame = Compass::default();
     let embree = EmbreeScene::build(m, |_| true).unwrap();
     let got = grid::work_plane(m, &embree, &frame, height, spacing);
     if let Ok(sensors) = &got {
@@ -287,7 +287,7 @@ fn grid_office_plane_avoids_the_furniture() {
 fn grid_spec_errors_name_the_flag() {
     let m = mesh(&room(3.0), false);
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
-    let frame = Frame::default();
+    let frame = Compass::default();
     let e = grid::work_plane(&m, &embree, &frame, 0.8, 1e-4).unwrap_err();
     assert!(matches!(e, GridError::TooMany { .. }), "{e}");
     assert!(
@@ -326,7 +326,7 @@ fn grid_office_at_two_million_columns() {
     let (_, m) = common::project_scene("office.obj");
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
     let t = std::time::Instant::now();
-    let got = grid::work_plane(&m, &embree, &Frame::default(), 0.8, 0.004).unwrap();
+    let got = grid::work_plane(&m, &embree, &Compass::default(), 0.8, 0.004).unwrap();
     eprintln!(
         "{} sensors in {:.2} s",
         got.len(),
