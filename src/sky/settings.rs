@@ -240,7 +240,16 @@ mod tests {
             ),
             (
                 SkySettings {
-                    sun: Some("2026-02-30T12:00+02:00".parse().unwrap()),
+                    // Parsing checks the date too; a date built in code is checked here.
+                    sun: Some(SunSetting::Time(DateTime {
+                        year: 2026,
+                        month: 2,
+                        day: 30,
+                        hour: 12,
+                        minute: 0,
+                        second: 0.0,
+                        utc_offset: 2.0,
+                    })),
                     site: Some((45.0, 0.0)),
                     ..overcast()
                 },
