@@ -1,5 +1,5 @@
-//! `radiosity bench elements`: adaptive elements against uniform meshing (issue 15, item 1;
-//! README, "Adaptive elements").
+//! `radiosity bench elements`: adaptive elements against uniform meshing (README, "Adaptive
+//! elements").
 //!
 //! One patch solve; then, on it, a fine *reference* (every patch cut uniformly to half the
 //! minimum element size, each corner gathered with many rays), *uniform* element meshes (every

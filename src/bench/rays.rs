@@ -1,6 +1,6 @@
 //! `radiosity bench rays`: the intersector's raw closest-hit throughput on random rays against
-//! the solver's rays per second, measured side by side in one run (issue 2's bar: the solver
-//! keeps at least 70 % of what Embree can do).
+//! the solver's rays per second, measured side by side in one run (the bar: the solver keeps
+//! at least 70 % of what Embree can do).
 
 use crate::intersect::select::IntersectorKind;
 use crate::intersect::{Intersector, Ray};

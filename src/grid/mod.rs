@@ -1,4 +1,4 @@
-//! The sensor grid of a daylight study (issue 14): where the illuminance is read, how sensors are
+//! The sensor grid of a daylight study: where the illuminance is read, how sensors are
 //! read from and written to CSV, the figures daylighting standards quote, and the plan picture.
 //!
 //! This module places sensors and reports values it is given; it computes no illuminance (the
