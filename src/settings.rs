@@ -5,7 +5,16 @@
 //! cut into patches), [`crate::solve::SolveSettings`] (how it is solved),
 //! [`crate::render::ViewSettings`] (camera and picture). Each checks itself, once, in the
 //! library, with a message that names the flag; the commands call those checks and add none of
-//! their own, so every command refuses what `solve` refuses, in the same words.
+//! their own, so every command refuses what `solve` refuses, in the same words. The daylight
+//! flags are [`crate::sky::SkySettings`], checked before any model is read; the benchmarks'
+//! jobs check themselves likewise (see [`crate::bench`]).
+//!
+//! The library's enums are the flags' values: `clap::ValueEnum` is derived on them (method,
+//! intersector, switch rule, element test, light groups, sky kind, bench ray kinds; the
+//! shading's is written out below), so the command line keeps no mirror of them, and the
+//! defaults `--help` shows are the library's. tests/settings_parity.rs walks clap's argument
+//! list and checks that every `solve` flag reaches the recorded settings
+//! ([`crate::pipeline::RunSettings`]) or is listed with the reason it does not.
 
 /// A setting a user got wrong: one line naming the flag and the value.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -16,5 +25,25 @@ impl Invalid {
     /// `Err(Invalid(message))`.
     pub fn err<T>(message: impl Into<String>) -> Result<T, Invalid> {
         Err(Invalid(message.into()))
+    }
+}
+
+/// No description of a flag's value in `--help` (the flag's own help says what its values
+/// mean): for the library enums whose variant docs are written for the code, not the user.
+/// `#[value(help = NO_HELP)]` on a `clap::ValueEnum` variant.
+pub const NO_HELP: Option<&str> = None;
+
+/// `--shading gather|gouraud`. Written out, not derived: [`crate::render::Shading`] lives with
+/// the renderer, and its flag spelling is its [`name`](crate::render::Shading::name).
+impl clap::ValueEnum for crate::render::Shading {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[
+            crate::render::Shading::Gather,
+            crate::render::Shading::Gouraud,
+        ]
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()))
     }
 }

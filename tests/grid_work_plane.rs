@@ -9,7 +9,7 @@ use radiosity::intersect::brute::BruteForce;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{Mesh, MeshOptions};
 use radiosity::scene::Scene;
-use radiosity::sky::Frame;
+use radiosity::sky::Compass;
 
 mod common;
 
@@ -73,7 +73,7 @@ fn mesh(s: &Scene, two_sided: bool) -> Mesh {
 
 /// The work plane by Embree, checked against the brute-force oracle (Y up, north −Z).
 fn plane(m: &Mesh, height: f32, spacing: f32) -> Result<Vec<Sensor>, GridError> {
-    let frame = Frame::default();
+    let frame = Compass::default();
     let embree = EmbreeScene::build(m, |_| true).unwrap();
     let got = grid::work_plane(m, &embree, &frame, height, spacing);
     if let Ok(sensors) = &got {
@@ -197,7 +197,7 @@ fn grid_follows_the_frame_north_and_zenith() {
     // North +X with Y up: east = north × up = +Z. The same 80 points, in rows along z.
     let m = mesh(&room(3.0), false);
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
-    let frame = Frame::new(Vec3::Y, Vec3::X).unwrap();
+    let frame = Compass::new(Vec3::Y, Vec3::X).unwrap();
     let got = grid::work_plane(&m, &embree, &frame, 0.8, 0.5).unwrap();
     let key = |s: &Sensor| (s.position.x.to_bits(), s.position.z.to_bits());
     let mut sorted = got.clone();
@@ -216,7 +216,7 @@ fn grid_follows_the_frame_north_and_zenith() {
     }
     let m = mesh(&z_up, false);
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
-    let frame = Frame::new(Vec3::Z, Vec3::Y).unwrap();
+    let frame = Compass::new(Vec3::Z, Vec3::Y).unwrap();
     let got = grid::work_plane(&m, &embree, &frame, 0.8, 0.5).unwrap();
     let want: Vec<Sensor> = lattice(0.8)
         .iter()
@@ -287,7 +287,7 @@ fn grid_office_plane_avoids_the_furniture() {
 fn grid_spec_errors_name_the_flag() {
     let m = mesh(&room(3.0), false);
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
-    let frame = Frame::default();
+    let frame = Compass::default();
     let e = grid::work_plane(&m, &embree, &frame, 0.8, 1e-4).unwrap_err();
     assert!(matches!(e, GridError::TooMany { .. }), "{e}");
     assert!(
@@ -326,7 +326,7 @@ fn grid_office_at_two_million_columns() {
     let (_, m) = common::project_scene("office.obj");
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
     let t = std::time::Instant::now();
-    let got = grid::work_plane(&m, &embree, &Frame::default(), 0.8, 0.004).unwrap();
+    let got = grid::work_plane(&m, &embree, &Compass::default(), 0.8, 0.004).unwrap();
     eprintln!(
         "{} sensors in {:.2} s",
         got.len(),

@@ -330,7 +330,7 @@ pub struct CrossReport {
     pub failures: Vec<String>,
 }
 
-/// The bar on the agreement rate of every pair (issue 4: 99.999 %).
+/// The bar on the agreement rate of every pair (99.999 %).
 pub const BAR_AGREEMENT: f64 = 0.99999;
 /// Share of the reference's surface rays that may escape before the scene is taken as open:
 /// a closed scene leaks none through a correct intersector, a leaky one a few per million,

@@ -1,5 +1,5 @@
 //! `radiosity bench elements`: adaptive elements against uniform meshing (docs/design.md §11;
-//! README, "Adaptive elements").
+//! docs/results/adaptive-elements.md).
 //!
 //! One patch solve; then, on it, a fine *reference* (every patch cut uniformly to half the
 //! minimum element size, each corner gathered with many rays), *uniform* element meshes (every
@@ -18,6 +18,7 @@ use crate::elements::{self, Elements, Rule, Test};
 use crate::intersect::select::IntersectorKind;
 use crate::light::LightAt;
 use crate::model::Model;
+use crate::settings::Invalid;
 use crate::solve::{scalar, SolveSettings};
 use crate::Error;
 use serde::Serialize;
@@ -37,6 +38,33 @@ pub struct ElementBenchJob {
     /// Rays per corner of the uniform and adaptive meshes, and of the reference.
     pub rays: usize,
     pub reference_rays: usize,
+}
+
+/// `radiosity bench elements --thresholds`: the adaptive meshes' thresholds.
+pub const DEFAULT_THRESHOLDS: &str = "0.005,0.01,0.02,0.04,0.08";
+/// `radiosity bench elements --tests`: what the thresholds apply to, each measured.
+pub const DEFAULT_TESTS: &str = "halves,midpoints";
+/// `radiosity bench elements --reference-rays`: rays per corner of the reference.
+pub const DEFAULT_REFERENCE_RAYS: usize = 2048;
+
+impl ElementBenchJob {
+    /// Refuses what `solve` refuses, the element settings `solve --elements` refuses, a
+    /// threshold that is no positive fraction and a reference of fewer than 2 rays per corner.
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.solve.check()?;
+        elements::ElementSettings {
+            min_size: self.min_size,
+            rays: self.rays.max(self.reference_rays.min(2)),
+            ..Default::default()
+        }
+        .check()?;
+        if self.thresholds.iter().any(|t| !(*t > 0.0 && t.is_finite())) || self.reference_rays < 2 {
+            return Invalid::err(
+                "--thresholds must be positive fractions and --reference-rays at least 2",
+            );
+        }
+        Ok(())
+    }
 }
 
 /// One mesh measured.
@@ -144,6 +172,7 @@ pub fn run(
     job: &ElementBenchJob,
     log: &mut dyn FnMut(&str),
 ) -> Result<ElementBenchReport, Error> {
+    job.check()?;
     let (isect, _) = model.intersector(IntersectorKind::Auto)?;
     let sol = model.solve(Some(&isect), &job.solve, &Default::default(), |_| {})?;
     let m = &model.mesh;

@@ -9,7 +9,17 @@ use crate::mesh::MeshOptions;
 use crate::model::Model;
 use crate::scene::SceneSource;
 use crate::scene::{self, LoadOptions, Scene};
+use crate::settings::Invalid;
 use crate::Error;
+
+/// Seed of the rays of `radiosity crosscheck` and `radiosity bench intersect` (`--seed`).
+pub const DEFAULT_SEED: u64 = 1;
+/// `radiosity crosscheck --eps`: the edge distance, relative to the scene's diagonal.
+pub const DEFAULT_EPS: f32 = 1e-5;
+/// `radiosity bench intersect --rays`: rays per intersector and scene.
+pub const DEFAULT_BENCH_RAYS: u64 = 1_000_000;
+/// `radiosity bench intersect --generated`: the generated buildings' sizes, in patches.
+pub const DEFAULT_GENERATED: &str = "1k,10k,100k";
 
 /// Everything `radiosity crosscheck` does.
 #[derive(Clone, Debug)]
@@ -41,18 +51,23 @@ impl std::fmt::Display for CrossCheck {
     }
 }
 
+impl CrossJob {
+    /// Refuses a bad patch size, no rays or an edge distance outside (0, 1).
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.mesh.check()?;
+        if self.rays == 0 {
+            return Invalid::err("--rays must be at least 1");
+        }
+        if !(self.eps > 0.0 && self.eps < 1.0) {
+            return Invalid::err(format!("--eps must be in (0, 1), got {}", self.eps));
+        }
+        Ok(())
+    }
+}
+
 /// Runs the cross-check; the bar's verdict is in the report (`passed`), not an error.
 pub fn crosscheck(job: &CrossJob) -> Result<CrossCheck, Error> {
-    job.mesh.check()?;
-    if job.rays == 0 {
-        return Err(Error::Invalid("--rays must be at least 1".into()));
-    }
-    if !(job.eps > 0.0 && job.eps < 1.0) {
-        return Err(Error::Invalid(format!(
-            "--eps must be in (0, 1), got {}",
-            job.eps
-        )));
-    }
+    job.check()?;
     let Model { scene, mesh: m } = Model::load(&job.source, &job.load, &job.mesh)?;
     if m.patches.is_empty() {
         return Err(Error::Invalid(format!(
@@ -107,8 +122,54 @@ pub struct BenchJob {
     /// Rays per intersector and scene.
     pub rays: u64,
     pub seed: u64,
-    /// Rays of this kind only (both kinds if `None`).
-    pub rays_from: Option<RaySource>,
+    /// Which rays are cast (`--source`).
+    pub rays_from: RaysFrom,
+}
+
+/// Which test rays `radiosity bench intersect` casts (`--source`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum RaysFrom {
+    /// Half of each kind. The default.
+    #[default]
+    #[value(help = crate::settings::NO_HELP)]
+    Both,
+    /// From patch surfaces, as the solver casts them.
+    #[value(help = crate::settings::NO_HELP)]
+    Surface,
+    /// Origin in the bounds, direction on the sphere.
+    #[value(help = crate::settings::NO_HELP)]
+    Uniform,
+}
+
+impl RaysFrom {
+    /// The one kind cast, or `None` for both.
+    pub fn only(self) -> Option<RaySource> {
+        match self {
+            RaysFrom::Both => None,
+            RaysFrom::Surface => Some(RaySource::Surface),
+            RaysFrom::Uniform => Some(RaySource::Uniform),
+        }
+    }
+}
+
+impl BenchJob {
+    /// Refuses a bad patch size, no rays or a generated size out of range.
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.mesh.check()?;
+        if self.rays == 0 {
+            return Invalid::err("--rays must be at least 1");
+        }
+        if let Some(&n) = self
+            .generated
+            .iter()
+            .find(|&&n| !(1..=10_000_000).contains(&n))
+        {
+            return Invalid::err(format!(
+                "--generated sizes must be between 1 and 10000000 patches, got {n}"
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// `radiosity bench intersect`: each scene, then each generated building, through every
@@ -117,20 +178,8 @@ pub fn bench_intersect(
     job: &BenchJob,
     mut log: impl FnMut(&BenchRow),
 ) -> Result<Vec<BenchRow>, Error> {
-    job.mesh.check()?;
-    if job.rays == 0 {
-        return Err(Error::Invalid("--rays must be at least 1".into()));
-    }
-    if let Some(&n) = job
-        .generated
-        .iter()
-        .find(|&&n| !(1..=10_000_000).contains(&n))
-    {
-        return Err(Error::Invalid(format!(
-            "--generated sizes must be between 1 and 10000000 patches, got {n}"
-        )));
-    }
-    let (rays, seed, from) = (job.rays, job.seed, job.rays_from);
+    job.check()?;
+    let (rays, seed, from) = (job.rays, job.seed, job.rays_from.only());
     let mut rows = Vec::new();
     for source in &job.scenes {
         let model = Model::load(source, &job.load, &job.mesh)?;

@@ -1,12 +1,17 @@
 //! Benchmarks and cross-checks, run by hand and reported in the README (never timed
 //! assertions in tests):
 //!
-//! - [`crosscheck`]: every intersector against a reference on the same rays (issue 4);
-//! - [`elements`](mod@elements): adaptive elements against uniform meshing (issue 15);
+//! - [`crosscheck`]: every intersector against a reference on the same rays;
+//! - [`elements`](mod@elements): adaptive elements against uniform meshing;
 //! - [`intersect`]: the jobs of `radiosity crosscheck` and `radiosity bench intersect`;
 //!   [`intersect_table`] their Markdown and CSV;
 //! - [`rays`]: raw Embree throughput against the solver's (`radiosity bench rays`);
+//! - [`shots`]: the cost per shot and the hybrid's switch (`radiosity bench shots`);
 //! - [`sweep`]: the scene-size performance sweep over generated buildings (`radiosity sweep`).
+//!
+//! Each command's job is a plain type here (`CrossJob`, `BenchJob`, `RaysJob`, `ShotsJob`,
+//! `ElementBenchJob`, `SweepJob`) whose `check()` refuses a bad flag before any work, with the
+//! one [`crate::settings::Invalid`] error; the binary only fills the jobs.
 
 pub mod crosscheck;
 pub mod elements;

@@ -1,12 +1,13 @@
 //! `radiosity bench rays`: the intersector's raw closest-hit throughput on random rays against
-//! the solver's rays per second, measured side by side in one run (issue 2's bar: the solver
-//! keeps at least 70 % of what Embree can do).
+//! the solver's rays per second, measured side by side in one run (the bar: the solver keeps
+//! at least 70 % of what Embree can do).
 
 use crate::intersect::select::IntersectorKind;
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::MeshOptions;
 use crate::model::Model;
 use crate::scene::{LoadOptions, SceneSource};
+use crate::settings::Invalid;
 use crate::solve::{self, SolveSettings};
 use crate::Error;
 use glam::Vec3;
@@ -99,28 +100,52 @@ pub fn raw_throughput<I: Intersector>(
     (chunks * 4096, t.elapsed().as_secs_f64())
 }
 
+/// `radiosity bench rays --rays`: random rays of the raw measurement.
+pub const DEFAULT_RAW_RAYS: u64 = 4_000_000;
+/// `radiosity bench rays --min-seconds`: the solves' least total time.
+pub const DEFAULT_MIN_SECONDS: f64 = 3.0;
+
+/// Everything `radiosity bench rays` does.
+#[derive(Clone, Debug)]
+pub struct RaysJob {
+    pub source: SceneSource,
+    pub load: LoadOptions,
+    pub mesh: MeshOptions,
+    /// The solves' settings (the method is always adaptive rays: the solver's rays are
+    /// measured).
+    pub solve: SolveSettings,
+    pub intersector: IntersectorKind,
+    /// Random rays for the raw measurement (a quarter before each solve).
+    pub raw_rays: u64,
+    /// Solve again until the solves took this long in all (seconds).
+    pub min_seconds: f64,
+}
+
+impl RaysJob {
+    /// Refuses what `solve` refuses, and a negative or non-finite `--min-seconds`.
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.mesh.check()?;
+        self.solve.check()?;
+        if !(self.min_seconds >= 0.0 && self.min_seconds.is_finite()) {
+            return Invalid::err(format!(
+                "--min-seconds must be a non-negative number, got {}",
+                self.min_seconds
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// `radiosity bench rays`: the intersector's raw throughput and the solver's, side by side in
 /// one run.
-pub fn bench_rays(
-    source: &SceneSource,
-    load: &LoadOptions,
-    mesh_opts: &MeshOptions,
-    cfg: &SolveSettings,
-    kind: IntersectorKind,
-    raw_rays: u64,
-    min_seconds: f64,
-) -> Result<RayBench, Error> {
-    cfg.check()?;
-    if !(min_seconds >= 0.0 && min_seconds.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "--min-seconds must be a non-negative number, got {min_seconds}"
-        )));
-    }
+pub fn bench_rays(job: &RaysJob) -> Result<RayBench, Error> {
+    job.check()?;
+    let (raw_rays, min_seconds) = (job.raw_rays, job.min_seconds);
     // The solver's rays are what is measured: the ray shooter, whatever --method says.
-    let cfg = &cfg.for_method(solve::MethodKind::AdaptiveRays);
-    let model = Model::load(source, load, mesh_opts)?;
+    let cfg = &job.solve.for_method(solve::MethodKind::AdaptiveRays);
+    let model = Model::load(&job.source, &job.load, &job.mesh)?;
     let (scene, m) = (&model.scene, &model.mesh);
-    let (isect, chosen) = model.intersector(kind)?;
+    let (isect, chosen) = model.intersector(job.intersector)?;
     let (lo, hi) = scene.bounds();
     // Warm up (page in the BVH, spin up the threads). Then alternate raw measurements and
     // solves (seeds seed, seed + 1, …) until the solves add up to `min_seconds`, ending with

@@ -23,6 +23,7 @@ use crate::model::Model;
 use crate::sample::hemicube::{Hemicube, HemicubeBuffer, ShotWork};
 use crate::sample::Frame;
 use crate::scene::{LoadOptions, Scene, SceneSource};
+use crate::settings::Invalid;
 use crate::solve::ray_shots::time_ray_shots;
 use crate::solve::switch::{self, CostModel, CubeWork};
 use crate::solve::{self, MethodKind, RunHooks, SolveSettings, SwitchBy, SwitchInfo};
@@ -418,17 +419,44 @@ fn hybrid(
     })
 }
 
-/// Runs the benchmark: uniform resolutions `ns`, from `shooters` patches.
-pub fn bench_shots(
-    source: &SceneSource,
-    load: &LoadOptions,
-    mesh_opts: &MeshOptions,
-    cfg: &SolveSettings,
-    ns: &[usize],
-    shooters: usize,
-) -> Result<ShotBench, Error> {
-    cfg.check()?;
-    let Model { scene, mesh: m } = Model::load(source, load, mesh_opts)?;
+/// `radiosity bench shots --resolutions`: the uniform hemi-cube resolutions compared.
+pub const DEFAULT_RESOLUTIONS: &str = "25,50,100,200";
+/// `radiosity bench shots --shooters`: patches shot from.
+pub const DEFAULT_SHOOTERS: usize = 64;
+
+/// Everything `radiosity bench shots` does.
+#[derive(Clone, Debug)]
+pub struct ShotsJob {
+    pub source: SceneSource,
+    pub load: LoadOptions,
+    pub mesh: MeshOptions,
+    /// The hybrid runs' settings (and the seed of the timed shots).
+    pub solve: SolveSettings,
+    /// Uniform hemi-cube resolutions to compare (`--resolutions`).
+    pub resolutions: Vec<usize>,
+    /// Patches to shoot from, spread over the scene (`--shooters`).
+    pub shooters: usize,
+}
+
+impl ShotsJob {
+    /// Refuses what `solve` refuses, and a resolution the hemi-cube does not take.
+    pub fn check(&self) -> Result<(), Invalid> {
+        self.mesh.check()?;
+        self.solve.check()?;
+        if let Some(&bad) = self.resolutions.iter().find(|&&n| !(2..=4096).contains(&n)) {
+            return Invalid::err(format!(
+                "--resolutions must be between 2 and 4096, got {bad}"
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Runs the benchmark: the job's uniform resolutions, from its shooters.
+pub fn bench_shots(job: &ShotsJob) -> Result<ShotBench, Error> {
+    job.check()?;
+    let (cfg, ns, shooters) = (&job.solve, &job.resolutions[..], job.shooters);
+    let Model { scene, mesh: m } = Model::load(&job.source, &job.load, &job.mesh)?;
     let n = m.patches.len();
     let count = shooters.clamp(1, n.max(1));
     let from: Vec<usize> = (0..count).map(|k| k * n / count).collect();

@@ -1,4 +1,4 @@
-//! `radiosity sweep`: the scene-size performance sweep (issue 8).
+//! `radiosity sweep`: the scene-size performance sweep.
 //!
 //! Over generated buildings from about 1 k to 1 M patches and more, for each size and method:
 //! load, mesh, intersector build and solve time; shots, rays, rays per second; peak memory (the

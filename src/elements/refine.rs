@@ -33,10 +33,13 @@ use std::collections::HashMap;
 pub const INSET: f64 = 2e-3;
 
 /// What an element's difference is measured on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Test {
     /// Cohen 1986 Sec. 3: the largest difference between the element's corners.
+    #[value(help = crate::settings::NO_HELP)]
     Corners,
     /// The largest difference, at the points the cut would add (edge midpoints, a quad's
     /// centre), between the radiosity gathered there and the element's interpolation of its
@@ -45,6 +48,7 @@ pub enum Test {
     /// of its patch's area (4^−depth): its part in the area-weighted error. Measured against
     /// `Corners` in README, "Adaptive elements": the same error with about a third of the
     /// elements.
+    #[value(help = crate::settings::NO_HELP)]
     Midpoints,
     /// The midpoint test, and a quad cut in *two* rather than four: across the direction in
     /// which cutting leaves the smaller interpolation error at the points gathered (a shadow
@@ -52,6 +56,7 @@ pub enum Test {
     /// cut in four spends three elements), the longer side when the two are alike. Two cuts
     /// in two make the cut in four where the light changes both ways. Triangles are cut in
     /// four. README, "Adaptive elements", measures it against [`Test::Midpoints`].
+    #[value(help = crate::settings::NO_HELP)]
     Halves,
 }
 

@@ -1,4 +1,4 @@
-//! The sensor grid of a daylight study (issue 14): where the illuminance is read, how sensors are
+//! The sensor grid of a daylight study: where the illuminance is read, how sensors are
 //! read from and written to CSV, the figures daylighting standards quote, and the plan picture.
 //!
 //! This module places sensors and reports values it is given; it computes no illuminance (the
@@ -16,7 +16,7 @@
 //! ([`GridStats`]: mean, minimum, uniformity U0 = min/mean, …) and a false-colour plan
 //! ([`plan_image`]: one top view per storey, a legend in lux, north up).
 //!
-//! **Orientation.** Plans are laid out in the sky's frame ([`Frame`]: east = north × zenith),
+//! **Orientation.** Plans are laid out in the sky's compass ([`Compass`]: east = north × zenith),
 //! so the grid and the sky can never disagree about which way is north. Coordinates are model
 //! units, taken to be metres (as the patch size and the sky are).
 //!
@@ -37,7 +37,7 @@ pub use work_plane::{work_plane, MAX_COLUMNS, MIN_STOREY_CLEARANCE};
 
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
-use crate::sky::Frame;
+use crate::sky::Compass;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 
@@ -65,16 +65,16 @@ pub enum GridSpec {
 }
 
 impl GridSpec {
-    /// The sensors this spec asks for in `mesh`, oriented by `frame`.
+    /// The sensors this spec asks for in `mesh`, oriented by `compass`.
     pub fn sensors<I: Intersector>(
         &self,
         mesh: &Mesh,
         isect: &I,
-        frame: &Frame,
+        compass: &Compass,
     ) -> Result<Vec<Sensor>, GridError> {
         match self {
             GridSpec::WorkPlane { height, spacing } => {
-                work_plane(mesh, isect, frame, *height, *spacing)
+                work_plane(mesh, isect, compass, *height, *spacing)
             }
             GridSpec::Points(path) => read_points(path),
         }

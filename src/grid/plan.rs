@@ -11,7 +11,7 @@
 use super::{spacing, storeys, Sensor};
 use crate::render::false_colour::{self, colour_at, Scale, BACKGROUND, LEGEND_WIDTH};
 use crate::render::glyphs;
-use crate::sky::Frame;
+use crate::sky::Compass;
 use glam::{DVec2, DVec3};
 
 /// Pixels around and between the panels.
@@ -23,7 +23,7 @@ const MIN_HEIGHT: u32 = 200;
 /// Text, the north marker and the storey labels.
 const INK: [u8; 3] = [230, 230, 230];
 
-/// The plan of `sensors` (with `lux`, one value per sensor) oriented by `frame`: panels `width`
+/// The plan of `sensors` (with `lux`, one value per sensor) oriented by `compass`: panels `width`
 /// pixels wide in all (at least 64) and the legend ([`LEGEND_WIDTH`]) to their right; the height
 /// follows from the plan's shape. `spacing_hint` is the cell size in metres (the lattice's
 /// spacing); 0 estimates it from the points (the median distance to the nearest neighbour).
@@ -33,14 +33,14 @@ const INK: [u8; 3] = [230, 230, 230];
 pub fn plan_image(
     sensors: &[Sensor],
     lux: &[f64],
-    frame: &Frame,
+    compass: &Compass,
     spacing_hint: f32,
     width: u32,
 ) -> image::RgbImage {
     assert_eq!(sensors.len(), lux.len(), "one lux value per sensor");
     let local: Vec<DVec3> = sensors
         .iter()
-        .map(|s| frame.to_local(s.position.as_dvec3()))
+        .map(|s| compass.to_local(s.position.as_dvec3()))
         .collect();
     let storey = storeys(&local.iter().map(|p| p.z).collect::<Vec<_>>());
     let cell = cell_size(&local, &storey, spacing_hint);
@@ -243,12 +243,12 @@ mod tests {
     #[test]
     fn grid_plan_colours_every_sensor_cell_with_its_lux() {
         let (s, lux) = two_storeys();
-        let frame = Frame::default();
-        let img = plan_image(&s, &lux, &frame, 0.5, 600);
+        let compass = Compass::default();
+        let img = plan_image(&s, &lux, &compass, 0.5, 600);
         assert_eq!(img.width(), 600 + LEGEND_WIDTH);
         let local: Vec<DVec3> = s
             .iter()
-            .map(|x| frame.to_local(x.position.as_dvec3()))
+            .map(|x| compass.to_local(x.position.as_dvec3()))
             .collect();
         let storey = storeys(&local.iter().map(|p| p.z).collect::<Vec<_>>());
         assert_eq!(storey.iter().max(), Some(&1));
@@ -280,22 +280,22 @@ mod tests {
         assert!(wx < ex && ny < sy);
         // Labels and the north marker are inked; a second call draws the same picture.
         assert!(img.pixels().filter(|p| p.0 == INK).count() > 50);
-        assert_eq!(plan_image(&s, &lux, &frame, 0.5, 600), img);
+        assert_eq!(plan_image(&s, &lux, &compass, 0.5, 600), img);
     }
 
     #[test]
     fn grid_plan_of_points_estimates_their_spacing() {
         let (s, lux) = two_storeys();
-        let frame = Frame::default();
+        let compass = Compass::default();
         assert_eq!(
-            plan_image(&s, &lux, &frame, 0.0, 300),
-            plan_image(&s, &lux, &frame, 0.5, 300),
+            plan_image(&s, &lux, &compass, 0.0, 300),
+            plan_image(&s, &lux, &compass, 0.5, 300),
             "a lattice's spacing is found from its points"
         );
-        let one = plan_image(&s[..1], &lux[..1], &frame, 0.0, 10);
+        let one = plan_image(&s[..1], &lux[..1], &compass, 0.0, 10);
         assert_eq!(one.width(), MIN_WIDTH + LEGEND_WIDTH);
         assert_eq!(one.height(), MIN_HEIGHT);
-        let none = plan_image(&[], &[], &frame, 0.0, 300);
+        let none = plan_image(&[], &[], &compass, 0.0, 300);
         assert_eq!(none.width(), 300 + LEGEND_WIDTH);
     }
 }

@@ -4,7 +4,7 @@
 //!
 //! # The rule
 //!
-//! - **Lattice.** Columns on a square lattice of SPACING aligned with east and north ([`Frame`]),
+//! - **Lattice.** Columns on a square lattice of SPACING aligned with east and north ([`Compass`]),
 //!   offset half a spacing from the model's plan bounds (the bounds of all its vertices seen
 //!   from above): the first column is half a spacing east and north of the south-west corner,
 //!   and columns stand strictly inside the bounds.
@@ -45,7 +45,7 @@
 use super::{check_plane, storeys, GridError, Sensor};
 use crate::intersect::{Hit, Intersector, Ray};
 use crate::mesh::Mesh;
-use crate::sky::Frame;
+use crate::sky::Compass;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -64,19 +64,19 @@ pub const FLOOR_COS: f32 = 0.99;
 pub const MAX_COLUMNS: f64 = 5e7;
 
 /// Sensors HEIGHT above each floor of `mesh` on a lattice of SPACING (the rule is in the
-/// [module docs](self)), facing the zenith of `frame`, in storey, row, column order.
+/// [module docs](self)), facing the zenith of `compass`, in storey, row, column order.
 ///
 /// Refuses a height or spacing that is not a positive length, a lattice of more than
 /// [`MAX_COLUMNS`] columns, and a model where no sensor can be placed.
 pub fn work_plane<I: Intersector>(
     mesh: &Mesh,
     isect: &I,
-    frame: &Frame,
+    compass: &Compass,
     height: f32,
     spacing: f32,
 ) -> Result<Vec<Sensor>, GridError> {
     check_plane(height, spacing)?;
-    let lattice = Lattice::new(mesh, frame, spacing as f64);
+    let lattice = Lattice::new(mesh, compass, spacing as f64);
     let columns = lattice.nx as f64 * lattice.ny as f64;
     if columns > MAX_COLUMNS {
         return Err(GridError::TooMany {
@@ -132,9 +132,9 @@ fn order(found: &mut [Found]) {
     }
 }
 
-/// The lattice over the model's plan, in the frame's local coordinates (east, north, up).
+/// The lattice over the model's plan, in the compass's local coordinates (east, north, up).
 struct Lattice {
-    frame: Frame,
+    compass: Compass,
     /// South-west corner of the plan bounds (east, north).
     e0: f64,
     n0: f64,
@@ -150,15 +150,15 @@ struct Lattice {
 }
 
 impl Lattice {
-    fn new(mesh: &Mesh, frame: &Frame, spacing: f64) -> Lattice {
-        let (lo, hi) = local_bounds(mesh, frame);
+    fn new(mesh: &Mesh, compass: &Compass, spacing: f64) -> Lattice {
+        let (lo, hi) = local_bounds(mesh, compass);
         let span = (hi - lo).max_element().max(0.0);
         let far = lo.abs().max(hi.abs()).max_element();
         // Columns strictly inside the bounds: e0 + (i + ½)s < e1.
         let count = |extent: f64| (extent / spacing - 0.5).ceil().max(0.0) as usize;
         let margin = 1.0 + 0.01 * span;
         Lattice {
-            frame: *frame,
+            compass: *compass,
             e0: lo.x,
             n0: lo.y,
             spacing,
@@ -182,17 +182,17 @@ impl Lattice {
     fn sensor(&self, f: &Found, height: f64) -> Sensor {
         Sensor {
             position: self
-                .frame
+                .compass
                 .to_world(self.local(f.i, f.j, f.u + height))
                 .as_vec3(),
-            normal: self.frame.up().as_vec3(),
+            normal: self.compass.up().as_vec3(),
         }
     }
 }
 
 /// The bounds of the mesh's vertices in local coordinates (east, north, up); zero when empty.
-fn local_bounds(mesh: &Mesh, frame: &Frame) -> (DVec3, DVec3) {
-    let mut it = mesh.vertices.iter().map(|v| frame.to_local(v.as_dvec3()));
+fn local_bounds(mesh: &Mesh, compass: &Compass) -> (DVec3, DVec3) {
+    let mut it = mesh.vertices.iter().map(|v| compass.to_local(v.as_dvec3()));
     let Some(first) = it.next() else {
         return (DVec3::ZERO, DVec3::ZERO);
     };
@@ -212,9 +212,9 @@ impl<I: Intersector> Column<'_, I> {
     /// The floors of column (i, j) with a sensor's room above them, top down.
     fn floors(&self, i: usize, j: usize) -> Vec<Found> {
         let l = self.lattice;
-        let down = -l.frame.up().as_vec3();
+        let down = -l.compass.up().as_vec3();
         let mut ray = Ray {
-            org: l.frame.to_world(l.local(i, j, l.top)).as_vec3(),
+            org: l.compass.to_world(l.local(i, j, l.top)).as_vec3(),
             dir: down,
             tnear: 0.0,
             tfar: l.depth as f32,
@@ -237,7 +237,7 @@ impl<I: Intersector> Column<'_, I> {
     fn floor_height(&self, i: usize, j: usize, hit: Hit) -> Option<f64> {
         let side = self.mesh.receiver(hit.patch, hit.back)?;
         let p = &self.mesh.patches[side as usize];
-        let f = &self.lattice.frame;
+        let f = &self.lattice.compass;
         let n = f.to_local(p.normal.as_dvec3());
         if n.z < FLOOR_COS as f64 {
             return None;
@@ -250,9 +250,9 @@ impl<I: Intersector> Column<'_, I> {
     /// Whether nothing is within `reach` straight above the floor at height `u`.
     fn is_clear(&self, i: usize, j: usize, u: f64) -> bool {
         let l = self.lattice;
-        let up: Vec3 = l.frame.up().as_vec3();
+        let up: Vec3 = l.compass.up().as_vec3();
         let ray = Ray {
-            org: l.frame.to_world(l.local(i, j, u)).as_vec3(),
+            org: l.compass.to_world(l.local(i, j, u)).as_vec3(),
             dir: up,
             tnear: l.eps as f32,
             tfar: self.reach,

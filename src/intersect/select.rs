@@ -28,17 +28,31 @@ pub enum SelectError {
 }
 
 /// `--intersector`: which intersector to cast through.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum IntersectorKind {
     /// Chosen per scene by [`auto_rule`].
     #[default]
+    #[value(help = crate::settings::NO_HELP)]
     Auto,
     /// Embree over the whole scene.
+    #[value(help = crate::settings::NO_HELP)]
     Embree,
     /// The plane merge alone: only for scenes whose patches are all axis-aligned.
+    #[value(help = crate::settings::NO_HELP)]
     Merge,
     /// The plane merge for axial patches, Embree for skew ones (Sec. 2).
+    #[value(help = crate::settings::NO_HELP)]
     Hybrid,
 }
 

@@ -6,7 +6,7 @@ use super::SolveJob;
 use crate::grid::{self, GridSpec, GridStats};
 use crate::intersect::select::AnyIntersector;
 use crate::light::LightAt;
-use crate::sky::{Frame, EFFICACY};
+use crate::sky::{Compass, EFFICACY};
 use crate::Error;
 
 /// Rays each sensor gathers by default (`--grid-rays`): about 1 % noise per sensor.
@@ -59,16 +59,16 @@ pub fn measure_grid(
 
 /// The model's orientation: the sky's zenith and north, else the job's (checked), else the
 /// defaults (Y up, north −Z).
-pub fn frame_of(job: &SolveJob) -> Frame {
+pub fn frame_of(job: &SolveJob) -> Compass {
     let (z, n) = job
         .settings
         .solve
         .sky
         .as_ref()
         .map_or((job.zenith, job.north), |s| (s.zenith, s.north));
-    Frame::new(z, n).unwrap_or_else(|_| {
-        Frame::new(crate::sky::DEFAULT_ZENITH, crate::sky::DEFAULT_NORTH)
-            .expect("the default frame is valid")
+    Compass::new(z, n).unwrap_or_else(|_| {
+        Compass::new(crate::sky::DEFAULT_ZENITH, crate::sky::DEFAULT_NORTH)
+            .expect("the default compass is valid")
     })
 }
 
@@ -88,7 +88,7 @@ fn measure(
     spec: &GridSpec,
     solved: &Solved,
     isect: &AnyIntersector,
-    frame: &Frame,
+    frame: &Compass,
 ) -> Result<GridResult, grid::GridError> {
     let (mesh, materials) = (&solved.model.mesh, &solved.model.scene.materials);
     let (b, sky) = (&solved.sol.b, solved.sky.as_ref());

@@ -121,8 +121,9 @@ pub struct SolveJob {
     pub grid: Option<crate::grid::GridSpec>,
     /// Rays each sensor gathers (`--grid-rays`).
     pub grid_rays: usize,
-    /// The model's up and north (`--zenith`, `--north`): the sky's frame, and the work plane's
-    /// up when a grid is asked for without a sky.
+    /// The model's up and north (`--zenith`, `--north`, the default north following the
+    /// zenith: [`crate::sky::Compass::default_north`]): the sky's compass, and the work
+    /// plane's up when a grid is asked for without a sky.
     pub zenith: glam::Vec3,
     pub north: glam::Vec3,
     /// How `render.png` is shaded (`--shading`, `--pixel-rays`; the seed is the solve's).
@@ -172,9 +173,12 @@ impl SolveJob {
                 self.checkpoint_every
             ));
         }
-        if self.grid.is_some() {
-            crate::sky::Frame::new(self.zenith, self.north)
-                .map_err(|e| Invalid(format!("--zenith/--north: {e}")))?;
+        // The orientation serves the sky and the grid's work plane; checked even without them.
+        crate::sky::Compass::new(self.zenith, self.north)?;
+        if self.grid.is_some() && !self.settings.solve.method.casts_rays() {
+            return Invalid::err(
+                "--grid needs a method that casts rays (adaptive-hybrid or adaptive-rays)",
+            );
         }
         Ok(())
     }

@@ -27,15 +27,20 @@
 use glam::DVec3;
 
 /// Which luminance distribution (the `--sky` flag).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum SkyKind {
-    /// Constant luminance (`gensky -u`).
-    Uniform,
     /// The CIE standard overcast sky (`gensky -c`).
+    #[value(help = crate::settings::NO_HELP)]
     Overcast,
     /// The CIE clear sky, which needs the sun's position (`gensky -s` / `+s`).
+    #[value(help = crate::settings::NO_HELP)]
     Clear,
+    /// Constant luminance (`gensky -u`).
+    #[value(help = crate::settings::NO_HELP)]
+    Uniform,
 }
 
 impl SkyKind {

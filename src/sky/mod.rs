@@ -1,9 +1,9 @@
-//! Daylight: the sky and the sun as distant emitters (issue 14).
+//! Daylight: the sky and the sun as distant emitters.
 //!
 //! This module owns the light that comes from outside the model: the sky's luminance
 //! distribution ([`cie`]: uniform, CIE overcast, CIE clear), the sun's position ([`solar`]: NOAA's
 //! algorithm) and disc ([`sun`]), the ground glow below the horizon, the model's orientation
-//! ([`frame`]) and the cut of all of it into directional pieces a shooter can fire parallel
+//! ([`compass`]), the daylight flags' settings and their check ([`settings`]) and the cut of all of it into directional pieces a shooter can fire parallel
 //! rays from ([`tregenza`], [`piece`]). It follows the conventions of Radiance's `gensky`, so a
 //! scene can be checked against Radiance:
 //!
@@ -27,18 +27,21 @@
 //! values (cd/m², lux) convert by [`EFFICACY`].
 
 pub mod cie;
-pub mod frame;
+pub mod compass;
 pub mod piece;
+pub mod settings;
 pub mod solar;
 pub mod sun;
 pub mod tregenza;
 
 pub use cie::SkyKind;
-pub use frame::{Frame, DEFAULT_NORTH, DEFAULT_ZENITH};
+pub use compass::{Compass, DEFAULT_NORTH, DEFAULT_ZENITH};
 pub use piece::{PieceKind, SkyPiece};
+pub use settings::{SkySettings, SunSetting};
 pub use solar::{DateTime, Site, SolarAngles};
 pub use sun::{Sun, SunLevel};
 
+use crate::settings::Invalid;
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
 
@@ -50,7 +53,8 @@ pub const EFFICACY: f64 = 179.0;
 /// `gensky`'s default ground reflectance (`-g`).
 pub const DEFAULT_GROUND_REFLECTANCE: f64 = 0.2;
 
-/// The default unobstructed horizontal illuminance of the sky, lux (issue 14's overcast default).
+/// The default unobstructed horizontal illuminance of the sky, lux (the overcast and uniform
+/// skies' default).
 pub const DEFAULT_SKY_ILLUMINANCE: f64 = 10_000.0;
 
 /// How bright the sky is; either value gives the other.
@@ -65,7 +69,9 @@ pub enum SkyLevel {
     Gensky,
 }
 
-/// What a sky is made of: the settings, unchecked until [`Sky::new`].
+/// What a sky is made of: the settings, checked by [`SkySpec::check`] (which [`Sky::new`]
+/// and [`crate::solve::SolveSettings::check`] call). The flags are turned into one by
+/// [`SkySettings::spec`].
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SkySpec {
     pub kind: SkyKind,
@@ -97,34 +103,11 @@ impl Default for SkySpec {
     }
 }
 
-/// A sky that cannot be built.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-pub enum SkyError {
-    #[error("the {which} direction {v} is zero or not finite")]
-    BadDirection { which: &'static str, v: Vec3 },
-    #[error("north {north} is parallel to the zenith {zenith}")]
-    Parallel { zenith: Vec3, north: Vec3 },
-    #[error("the ground reflectance {0} is not within [0, 1]")]
-    BadReflectance(f64),
-    #[error("the {what} {value} is not a finite, non-negative number")]
-    BadLevel { what: &'static str, value: f64 },
-    #[error("{0} needs the sun's position (altitude and azimuth, or a site and a time)")]
-    NoSunPosition(&'static str),
-    #[error(
-        "solar altitude {altitude}° and azimuth {azimuth}°: the altitude must be within [-90, 90]"
-    )]
-    BadAngles { altitude: f64, azimuth: f64 },
-    #[error("latitude {latitude}°, longitude {longitude}° is not a place on the earth")]
-    BadSite { latitude: f64, longitude: f64 },
-    #[error("bad date and time: {0}")]
-    BadTime(String),
-}
-
 /// A sky ready to light a scene.
 #[derive(Clone, Debug)]
 pub struct Sky {
     kind: SkyKind,
-    frame: Frame,
+    compass: Compass,
     /// The sun's direction for the clear sky's distribution (local; the zenith if unused).
     sun_local: DVec3,
     sun_position: Option<SolarAngles>,
@@ -141,9 +124,9 @@ pub struct Sky {
 
 impl Sky {
     /// Checks `spec` and builds the sky, its sun and its pieces.
-    pub fn new(spec: &SkySpec) -> Result<Sky, SkyError> {
-        let frame = Frame::new(spec.zenith, spec.north)?;
-        check(spec)?;
+    pub fn new(spec: &SkySpec) -> Result<Sky, Invalid> {
+        spec.check()?;
+        let compass = Compass::new(spec.zenith, spec.north)?;
         let sun_local = spec.sun_position.map_or(DVec3::Z, |a| a.local_dir());
         let bands = tregenza::patches();
         // ∫ (L / L_z) cos θ dω per patch: the pieces' radiances and, summed, E_h / L_z.
@@ -154,13 +137,13 @@ impl Sky {
         let ratio: f64 = q.iter().sum();
         let zenith_radiance = zenith_radiance(spec, ratio);
         let sun = match (spec.sun, spec.sun_position) {
-            (Some(level), Some(angles)) => Sun::new(angles, level, &frame),
+            (Some(level), Some(angles)) => Sun::new(angles, level, &compass),
             _ => None,
         };
         let e_total = zenith_radiance * ratio + sun.map_or(0.0, |s| s.horizontal_irradiance());
         let mut sky = Sky {
             kind: spec.kind,
-            frame,
+            compass,
             sun_local,
             sun_position: spec.sun_position,
             sun,
@@ -178,7 +161,7 @@ impl Sky {
     fn build_pieces(&self, bands: &[tregenza::Band], q: &[f64]) -> Vec<SkyPiece> {
         let sky = bands.iter().zip(q).enumerate().map(|(k, (b, qk))| {
             let radiance = self.zenith_radiance * qk / b.projected_solid_angle();
-            SkyPiece::band(PieceKind::Sky, k, *b, radiance, self.frame)
+            SkyPiece::band(PieceKind::Sky, k, *b, radiance, self.compass)
         });
         let ground = bands.iter().enumerate().map(|(k, b)| {
             SkyPiece::band(
@@ -186,10 +169,10 @@ impl Sky {
                 k,
                 b.mirrored(),
                 self.ground_radiance,
-                self.frame,
+                self.compass,
             )
         });
-        let sun = self.sun.iter().map(|s| SkyPiece::sun(s, self.frame));
+        let sun = self.sun.iter().map(|s| SkyPiece::sun(s, self.compass));
         sky.chain(ground).chain(sun).collect()
     }
 
@@ -204,7 +187,7 @@ impl Sky {
     /// through [`Sky::sun`], as a tiny bright disc is missed by hemisphere sampling.
     pub fn radiance(&self, dir_to_sky: Vec3) -> [f64; 3] {
         let d = self
-            .frame
+            .compass
             .to_local(dir_to_sky.as_dvec3().normalize_or_zero());
         if d.z > 0.0 {
             [self.zenith_radiance * self.kind.relative(d, self.sun_local); 3]
@@ -255,47 +238,61 @@ impl Sky {
         self.kind
     }
 
-    pub fn frame(&self) -> &Frame {
-        &self.frame
+    pub fn compass(&self) -> &Compass {
+        &self.compass
     }
 }
 
-/// Refuses a spec whose numbers are out of range or which lacks a sun position it needs.
-fn check(spec: &SkySpec) -> Result<(), SkyError> {
-    let rho = spec.ground_reflectance;
-    if !(0.0..=1.0).contains(&rho) {
-        return Err(SkyError::BadReflectance(rho));
-    }
-    let level = match spec.level {
-        SkyLevel::ZenithLuminance(v) => Some(("zenith luminance", v)),
-        SkyLevel::HorizontalIlluminance(v) => Some(("sky illuminance", v)),
-        SkyLevel::Gensky => None,
-    };
-    let sun = match spec.sun {
-        Some(SunLevel::NormalIlluminance(v)) => Some(("sun's normal illuminance", v)),
-        Some(SunLevel::HorizontalIlluminance(v)) => Some(("sun's horizontal illuminance", v)),
-        _ => None,
-    };
-    for (what, value) in level.into_iter().chain(sun) {
-        if !(value.is_finite() && value >= 0.0) {
-            return Err(SkyError::BadLevel { what, value });
+impl SkySpec {
+    /// Refuses a spec whose directions are no compass ([`Compass::new`]), whose numbers are
+    /// out of range or which lacks a sun position it needs: one line naming the flag.
+    pub fn check(&self) -> Result<(), Invalid> {
+        Compass::new(self.zenith, self.north)?;
+        let rho = self.ground_reflectance;
+        if !(0.0..=1.0).contains(&rho) {
+            return Invalid::err(format!(
+                "--ground-reflectance: the ground reflectance {rho} is not within [0, 1]"
+            ));
         }
-    }
-    if spec.sun_position.is_none() {
-        let needs = if spec.kind.needs_sun_position() {
-            Some("the clear sky")
-        } else if spec.sun.is_some() {
-            Some("a sun")
-        } else if spec.level == SkyLevel::Gensky {
-            Some("gensky's default sky brightness")
-        } else {
-            None
+        let level = match self.level {
+            SkyLevel::ZenithLuminance(v) => Some(("--zenith-luminance", "zenith luminance", v)),
+            SkyLevel::HorizontalIlluminance(v) => Some(("--sky-illuminance", "sky illuminance", v)),
+            SkyLevel::Gensky => None,
         };
-        if let Some(what) = needs {
-            return Err(SkyError::NoSunPosition(what));
+        let sun = match self.sun {
+            Some(SunLevel::NormalIlluminance(v)) => {
+                Some(("--sun-illuminance", "sun's normal illuminance", v))
+            }
+            Some(SunLevel::HorizontalIlluminance(v)) => {
+                Some(("--sun", "sun's horizontal illuminance", v))
+            }
+            _ => None,
+        };
+        for (flag, what, value) in level.into_iter().chain(sun) {
+            if !(value.is_finite() && value >= 0.0) {
+                return Invalid::err(format!(
+                    "{flag}: the {what} {value} is not a finite, non-negative number"
+                ));
+            }
         }
+        if self.sun_position.is_none() {
+            let needs = if self.kind.needs_sun_position() {
+                Some("the clear sky")
+            } else if self.sun.is_some() {
+                Some("a sun")
+            } else if self.level == SkyLevel::Gensky {
+                Some("gensky's default sky brightness")
+            } else {
+                None
+            };
+            if let Some(what) = needs {
+                return Invalid::err(format!(
+                    "--sky: {what} needs the sun's position (altitude and azimuth, or a site and a time)"
+                ));
+            }
+        }
+        Ok(())
     }
-    Ok(())
 }
 
 /// L_z in W/sr/m² from the spec's level, E_h / L_z being `ratio`.

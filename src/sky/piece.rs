@@ -11,7 +11,7 @@
 //! 12° bands keep the directions as fine as the sky's, one code path serves both, and with equal
 //! energy per ray the extra pieces cost shots, not rays.
 
-use super::frame::Frame;
+use super::compass::Compass;
 use super::sun::Sun;
 use super::tregenza::Band;
 use glam::Vec3;
@@ -61,7 +61,7 @@ pub struct SkyPiece {
     /// the sun.
     pub index: usize,
     region: Region,
-    frame: Frame,
+    compass: Compass,
 }
 
 impl SkyPiece {
@@ -71,22 +71,22 @@ impl SkyPiece {
         index: usize,
         band: Band,
         radiance: f64,
-        frame: Frame,
+        compass: Compass,
     ) -> SkyPiece {
         SkyPiece {
-            dir: frame.to_world(band.centre()).as_vec3(),
+            dir: compass.to_world(band.centre()).as_vec3(),
             solid_angle: band.solid_angle(),
             projected_solid_angle: band.projected_solid_angle(),
             radiance: [radiance; 3],
             kind,
             index,
             region: Region::Band(band),
-            frame,
+            compass,
         }
     }
 
     /// The solar disc.
-    pub(crate) fn sun(sun: &Sun, frame: Frame) -> SkyPiece {
+    pub(crate) fn sun(sun: &Sun, compass: Compass) -> SkyPiece {
         SkyPiece {
             dir: sun.dir,
             solid_angle: Sun::solid_angle(),
@@ -95,7 +95,7 @@ impl SkyPiece {
             kind: PieceKind::Sun,
             index: 0,
             region: Region::Sun(*sun),
-            frame,
+            compass,
         }
     }
 
@@ -108,7 +108,7 @@ impl SkyPiece {
     /// angle over it; the map is continuous, so stratified (u, v) give stratified directions.
     pub fn sample(&self, u: f64, v: f64) -> Vec3 {
         match self.region {
-            Region::Band(b) => self.frame.to_world(b.local_dir(u, v)).as_vec3(),
+            Region::Band(b) => self.compass.to_world(b.local_dir(u, v)).as_vec3(),
             Region::Sun(sun) => sun.sample(u, v),
         }
     }

@@ -17,7 +17,7 @@
 //! Azimuth follows `gensky`: degrees **west of south** (south 0°, west 90°, north ±180°,
 //! east −90°). [`SolarAngles::azimuth_from_north`] gives the compass bearing (east of north).
 
-use super::SkyError;
+use crate::settings::Invalid;
 use glam::DVec3;
 use std::str::FromStr;
 
@@ -33,9 +33,11 @@ pub struct SolarAngles {
 impl SolarAngles {
     /// Altitude and azimuth (degrees west of south), as `gensky -ang ALT AZI`. Refuses
     /// non-finite values and an altitude outside [−90°, 90°].
-    pub fn new(altitude: f64, azimuth: f64) -> Result<SolarAngles, SkyError> {
+    pub fn new(altitude: f64, azimuth: f64) -> Result<SolarAngles, Invalid> {
         if !(altitude.is_finite() && azimuth.is_finite() && altitude.abs() <= 90.0) {
-            return Err(SkyError::BadAngles { altitude, azimuth });
+            return Invalid::err(format!(
+                "--sun: solar altitude {altitude}° and azimuth {azimuth}°: the altitude must be within [-90, 90]"
+            ));
         }
         Ok(SolarAngles { altitude, azimuth })
     }
@@ -81,12 +83,11 @@ pub struct Site {
 
 impl Site {
     /// Latitude (°N) and longitude (°E); refuses values off the globe.
-    pub fn new(latitude: f64, longitude: f64) -> Result<Site, SkyError> {
+    pub fn new(latitude: f64, longitude: f64) -> Result<Site, Invalid> {
         if !(latitude.abs() <= 90.0 && longitude.abs() <= 180.0) {
-            return Err(SkyError::BadSite {
-                latitude,
-                longitude,
-            });
+            return Invalid::err(format!(
+                "--site: latitude {latitude}°, longitude {longitude}° is not a place on the earth"
+            ));
         }
         Ok(Site {
             latitude,
@@ -95,7 +96,7 @@ impl Site {
     }
 
     /// `gensky -a LAT -o LON`: `gensky`'s longitude is degrees **west**.
-    pub fn from_gensky(latitude: f64, longitude_west: f64) -> Result<Site, SkyError> {
+    pub fn from_gensky(latitude: f64, longitude_west: f64) -> Result<Site, Invalid> {
         Site::new(latitude, -longitude_west)
     }
 }
@@ -121,7 +122,7 @@ pub struct DateTime {
 
 impl DateTime {
     /// Checks the fields' ranges (the day against the month, leap years included).
-    pub fn validate(&self) -> Result<(), SkyError> {
+    pub fn validate(&self) -> Result<(), Invalid> {
         let ok = (1..=12).contains(&self.month)
             && self.day >= 1
             && self.day <= days_in_month(self.year, self.month)
@@ -132,7 +133,7 @@ impl DateTime {
         if ok {
             Ok(())
         } else {
-            Err(SkyError::BadTime(format!("{self:?}")))
+            Invalid::err(format!("--sun: bad date and time: {self:?}"))
         }
     }
 
@@ -154,12 +155,17 @@ impl DateTime {
 }
 
 /// `YYYY-MM-DDTHH:MM[:SS[.s]]` then `Z` or `±HH[:MM]` (a space may stand for the `T`), e.g.
-/// `2003-10-17T12:30:30-07:00`. The offset is required: a local time alone is ambiguous.
+/// `2003-10-17T12:30:30-07:00`. The offset is required: a local time alone is ambiguous. The
+/// error does not name the flag (the flag's parser does).
 impl FromStr for DateTime {
-    type Err = SkyError;
+    type Err = Invalid;
 
-    fn from_str(s: &str) -> Result<DateTime, SkyError> {
-        let bad = || SkyError::BadTime(format!("{s:?} (expected e.g. 2003-10-17T12:30:30-07:00)"));
+    fn from_str(s: &str) -> Result<DateTime, Invalid> {
+        let bad = || {
+            Invalid(format!(
+                "bad date and time: {s:?} (expected e.g. 2003-10-17T12:30:30-07:00)"
+            ))
+        };
         let s = s.trim();
         let (date, rest) = s.split_once(['T', ' ']).ok_or_else(bad)?;
         let (clock, utc_offset) = split_offset(rest.trim()).ok_or_else(bad)?;

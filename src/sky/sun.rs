@@ -15,7 +15,7 @@
 //! in lux by this crate's [`super::EFFICACY`] (179 lm/W, as `rtrace -I` users multiply by) that is
 //! 77,452 lux overhead, 66,066 lux at 30°.
 
-use super::frame::Frame;
+use super::compass::Compass;
 use super::solar::SolarAngles;
 use super::EFFICACY;
 use glam::{DVec3, Vec3};
@@ -49,9 +49,9 @@ pub struct Sun {
 }
 
 impl Sun {
-    /// The sun at `angles`, as bright as `level` says, oriented by `frame`; `None` when its
+    /// The sun at `angles`, as bright as `level` says, oriented by `compass`; `None` when its
     /// centre is not above the horizon.
-    pub fn new(angles: SolarAngles, level: SunLevel, frame: &Frame) -> Option<Sun> {
+    pub fn new(angles: SolarAngles, level: SunLevel, compass: &Compass) -> Option<Sun> {
         if angles.altitude <= 0.0 {
             return None;
         }
@@ -61,7 +61,7 @@ impl Sun {
             SunLevel::NormalIlluminance(lux) => lux / EFFICACY,
             SunLevel::HorizontalIlluminance(lux) => lux / EFFICACY / sin_h,
         };
-        let dir64 = frame.to_world(angles.local_dir()).normalize();
+        let dir64 = compass.to_world(angles.local_dir()).normalize();
         Some(Sun {
             dir: dir64.as_vec3(),
             angles,
@@ -125,8 +125,8 @@ fn cone_sample(axis: DVec3, cos_max: f64, u: f64, v: f64) -> DVec3 {
 mod tests {
     use super::*;
 
-    fn frame() -> Frame {
-        Frame::default()
+    fn compass() -> Compass {
+        Compass::default()
     }
 
     #[test]
@@ -137,7 +137,7 @@ mod tests {
         let sun = Sun::new(
             SolarAngles::new(30.0, 0.0).unwrap(),
             SunLevel::Gensky,
-            &frame(),
+            &compass(),
         );
         let lux = sun.unwrap().normal_illuminance();
         assert!((lux - 432.6923 * 0.853 * 179.0).abs() < 0.1, "{lux}");
@@ -146,7 +146,7 @@ mod tests {
     #[test]
     fn disc_radiance_gives_the_normal_irradiance() {
         let angles = SolarAngles::new(40.0, 20.0).unwrap();
-        let sun = Sun::new(angles, SunLevel::NormalIlluminance(80_000.0), &frame()).unwrap();
+        let sun = Sun::new(angles, SunLevel::NormalIlluminance(80_000.0), &compass()).unwrap();
         // L_s · π sin²α = E_n exactly; E_n sin h on the horizontal.
         let e_n = sun.radiance()[0] * PI * Sun::half_angle().sin().powi(2);
         assert!((e_n * EFFICACY - 80_000.0).abs() < 1e-9);
@@ -163,21 +163,26 @@ mod tests {
     #[test]
     fn horizontal_level_is_divided_by_sin_h() {
         let angles = SolarAngles::new(30.0, 0.0).unwrap();
-        let sun = Sun::new(angles, SunLevel::HorizontalIlluminance(50_000.0), &frame()).unwrap();
+        let sun = Sun::new(
+            angles,
+            SunLevel::HorizontalIlluminance(50_000.0),
+            &compass(),
+        )
+        .unwrap();
         assert!((sun.normal_illuminance() - 100_000.0).abs() < 1e-6);
     }
 
     #[test]
     fn sun_below_the_horizon_is_none() {
         let angles = SolarAngles::new(-2.0, 0.0).unwrap();
-        assert!(Sun::new(angles, SunLevel::Gensky, &frame()).is_none());
+        assert!(Sun::new(angles, SunLevel::Gensky, &compass()).is_none());
     }
 
     #[test]
     fn samples_fall_in_the_disc_and_sun_points_the_gensky_way() {
-        // South at 45° in the default frame (north −Z, up +Y): +Z and +Y.
+        // South at 45° in the default compass (north −Z, up +Y): +Z and +Y.
         let angles = SolarAngles::new(45.0, 0.0).unwrap();
-        let sun = Sun::new(angles, SunLevel::Gensky, &frame()).unwrap();
+        let sun = Sun::new(angles, SunLevel::Gensky, &compass()).unwrap();
         assert!((sun.dir - Vec3::new(0.0, 1.0, 1.0).normalize()).length() < 1e-6);
         let cos_max = Sun::half_angle().cos();
         for (u, v) in [(0.0, 0.0), (1.0, 0.25), (0.5, 0.9)] {

@@ -9,13 +9,25 @@ use crate::mesh::Mesh;
 use crate::scene::Scene;
 
 /// How lights are grouped into channels.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum GroupBy {
     /// One channel per emitting material (named after it).
     #[default]
+    #[value(help = "One channel per emitting material")]
     Material,
     /// One channel per connected emitting surface (named `material#k`).
+    #[value(help = "One channel per connected emitting surface (fixtures of one material apart)")]
     Connected,
 }
 

@@ -41,25 +41,39 @@ pub const MAX_GATHER_RAYS: usize = 1_000_000;
 pub const REFERENCE_TOLERANCE: f64 = 0.005;
 pub const REFERENCE_STOP: f64 = 1e-5;
 
-/// How form factors are sampled (`radiosity solve --method …`; the paper's Sec. 2 and 4).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+/// How form factors are sampled (`radiosity solve --method …`; the paper's Sec. 2 and 4). The
+/// flag's values are the variants' kebab-case names (as in the JSON), each with a one-line
+/// description for `--help`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum MethodKind {
     /// Shooting with the adaptive polar hemisphere ray sampler (Sec. 2).
+    #[value(help = "Shooting with the paper's adaptive polar hemisphere ray sampler (Sec. 2)")]
     AdaptiveRays,
     /// Shooting with the uniform N×N hemi-cube of Cohen & Greenberg 1985: the non-adaptive
     /// baseline.
+    #[value(
+        help = "Shooting with the uniform N×N hemi-cube (Cohen & Greenberg 1985): the baseline"
+    )]
     Hemicube,
     /// The uniform hemi-cube with each cell's sample point jittered (Table 1, third column).
+    #[value(help = "The uniform hemi-cube with jittered sample points (the paper's Table 1)")]
     HemicubeJittered,
     /// Shooting with the paper's non-uniform hemi-cube, its resolution from the unshot energy.
+    #[value(
+        help = "Shooting with the paper's non-uniform hemi-cube, resolution from the unshot energy"
+    )]
     AdaptiveHemicube,
     /// The adaptive hemi-cube while shots carry much energy, then adaptive rays once a ray shot
     /// is cheaper (Sec. 4: curves C then D). The default.
     #[default]
+    #[value(
+        help = "Adaptive hemi-cube first, adaptive rays once cheaper by the cost model (Sec. 4)"
+    )]
     AdaptiveHybrid,
     /// The matrix method ([`super::matrix`]), the traditional algorithm: full form-factor
     /// matrix by the uniform hemi-cube, then Gauss–Seidel. Named `gathering` on the command line.
+    #[value(help = "The traditional algorithm: full form-factor matrix, then Gauss–Seidel")]
     Gathering,
 }
 
@@ -101,7 +115,7 @@ impl MethodKind {
 
 /// How `adaptive-hybrid` decides when rays become cheaper than hemi-cubes (Sec. 4;
 /// `--switch-by`). See [`super::switch`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum SwitchBy {
     /// From counted work (patches transformed, faces clipped, cells cleared and tested; rays
@@ -109,10 +123,12 @@ pub enum SwitchBy {
     /// `radiosity bench shots`): the same switch shot on every run and thread count. The
     /// default.
     #[default]
+    #[value(help = crate::settings::NO_HELP)]
     Counted,
     /// From times measured during the solve (a least-squares fit of hemi-cube shot times
     /// against cells, and a timed probe of a few thousand rays): adapts to the machine, but
     /// the switch shot, and so the result, varies from run to run.
+    #[value(help = crate::settings::NO_HELP)]
     Measured,
 }
 
@@ -166,7 +182,7 @@ pub struct SolveSettings {
     /// After shooting, re-estimate the patches the shooting left noisy by gathering with
     /// rays of their own ([`super::final_gather`]); methods that cast rays only.
     pub final_gather: bool,
-    /// Daylight (issue 14): the sky, ground glow and sun that shoot at the model from outside
+    /// Daylight: the sky, ground glow and sun that shoot at the model from outside
     /// ([`super::sky_shots`]); `None` for none.
     pub sky: Option<crate::sky::SkySpec>,
     /// Rays per gathered patch at the default tolerance ([`SolveSettings::gather_rays_per_patch`]).
@@ -206,6 +222,21 @@ impl SolveSettings {
             tolerance: REFERENCE_TOLERANCE,
             stop_fraction: REFERENCE_STOP,
             ..SolveSettings::default()
+        }
+    }
+
+    /// `radiosity solve`'s error policy where `--error` is left out: the methods that cast rays
+    /// refine to [`DEFAULT_ERROR_TARGET`], giving up after [`DEFAULT_ERROR_MAX_FACTOR`] times
+    /// the first pass's samples; the others make one pass, as the paper.
+    pub fn with_solve_default_error(self) -> SolveSettings {
+        if self.method.casts_rays() {
+            SolveSettings {
+                error_target: Some(DEFAULT_ERROR_TARGET),
+                error_max_factor: Some(DEFAULT_ERROR_MAX_FACTOR),
+                ..self
+            }
+        } else {
+            self
         }
     }
 
@@ -304,6 +335,15 @@ impl SolveSettings {
                 "--switch-at applies to --method adaptive-hybrid only, not {}",
                 self.method.name()
             ));
+        }
+        if let Some(sky) = &self.sky {
+            sky.check()?;
+            if !self.method.casts_rays() {
+                return Invalid::err(format!(
+                    "--sky needs a method that casts rays (adaptive-hybrid or adaptive-rays), not --method {}",
+                    self.method.name()
+                ));
+            }
         }
         Ok(())
     }

@@ -12,8 +12,6 @@ use radiosity::render::view_file::RadianceView;
 use radiosity::render::{CameraSpec, RenderOptions, Shading, ShadingSettings, ViewSettings};
 use radiosity::saved::SceneCheck;
 use radiosity::scene::{LoadOptions, SceneSource};
-use radiosity::solve::lights::GroupBy;
-use radiosity::solve::settings::{DEFAULT_ERROR_MAX_FACTOR, DEFAULT_ERROR_TARGET};
 use radiosity::solve::settings::{
     DEFAULT_FINAL_GATHER, DEFAULT_GATHER_CAP_MIB, DEFAULT_GATHER_RAYS, DEFAULT_HEMICUBE_N,
 };
@@ -94,8 +92,8 @@ pub struct SamplingArgs {
     pub gather_cap_mib: u64,
     /// Ray intersector: auto picks per scene (the rule is in `radiosity info`); merge needs a
     /// scene whose patches are all axis-aligned.
-    #[arg(long, value_enum, default_value_t = IntersectorArg::Auto)]
-    pub intersector: IntersectorArg,
+    #[arg(long, value_enum, default_value_t = IntersectorKind::default())]
+    pub intersector: IntersectorKind,
     /// After shooting, every patch gathers its own light with rays: shadow rays to the lights
     /// and hemisphere rays (followed on through narrow gaps), weighed against the shooting's
     /// estimate (methods that cast rays).
@@ -167,8 +165,8 @@ pub struct SolverArgs {
     #[arg(long = "error", value_name = "FRACTION|off", value_parser = parse_error_target, allow_negative_numbers = true)]
     pub error_target: Option<ErrorTarget>,
     /// How form factors are sampled.
-    #[arg(long, value_enum, default_value_t = Method::AdaptiveHybrid)]
-    pub method: Method,
+    #[arg(long, value_enum, default_value_t = MethodKind::default())]
+    pub method: MethodKind,
     /// adaptive-hybrid: switch from hemi-cubes to rays at this shot instead of when the cost
     /// model says so (the switch shot a summary.json recorded).
     #[arg(long, value_name = "SHOT")]
@@ -176,8 +174,8 @@ pub struct SolverArgs {
     /// adaptive-hybrid: decide the switch from counted work weighed by the kept cost constants
     /// (reproducible on every run), or from times measured during the solve (adapts to the
     /// machine; the result then varies from run to run).
-    #[arg(long, value_enum, default_value_t = SwitchByArg::Counted)]
-    pub switch_by: SwitchByArg,
+    #[arg(long, value_enum, default_value_t = SwitchBy::default())]
+    pub switch_by: SwitchBy,
 }
 
 /// `--error`: a fraction, or `off`.
@@ -197,62 +195,36 @@ fn parse_error_target(s: &str) -> Result<ErrorTarget, String> {
     }
 }
 
-/// `--switch-by`: see `radiosity::solve::SwitchBy`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum SwitchByArg {
-    Counted,
-    Measured,
-}
-
-impl From<SwitchByArg> for SwitchBy {
-    fn from(a: SwitchByArg) -> SwitchBy {
-        match a {
-            SwitchByArg::Counted => SwitchBy::Counted,
-            SwitchByArg::Measured => SwitchBy::Measured,
-        }
-    }
-}
-
 impl SolverArgs {
     /// The settings, with no error target unless `--error` gives one.
     pub fn settings(&self) -> SolveSettings {
-        self.settings_with_error(None)
-    }
-
-    /// The settings of `radiosity solve`: without `--error`, the ray methods refine to
-    /// [`DEFAULT_ERROR_TARGET`].
-    pub fn solve_settings(&self) -> SolveSettings {
-        let method: MethodKind = self.method.into();
-        let casts_rays = matches!(
-            method,
-            MethodKind::AdaptiveHybrid | MethodKind::AdaptiveRays
-        );
-        let mut s = self.settings_with_error(casts_rays.then_some(DEFAULT_ERROR_TARGET));
-        if self.error_target.is_none() && s.error_target.is_some() {
-            s.error_max_factor = Some(DEFAULT_ERROR_MAX_FACTOR);
-        }
-        s
-    }
-
-    fn settings_with_error(&self, default: Option<f64>) -> SolveSettings {
         let error_target = match self.error_target {
-            None => default,
-            Some(ErrorTarget::Off) => None,
+            None | Some(ErrorTarget::Off) => None,
             Some(ErrorTarget::At(e)) => Some(e),
         };
         SolveSettings {
-            method: self.method.into(),
+            method: self.method,
             max_time: self.max_time,
             max_rays: self.max_rays,
             error_target,
             switch_at: self.switch_at,
-            switch_by: self.switch_by.into(),
+            switch_by: self.switch_by,
             ..self.sampling.over(SolveSettings::default())
         }
     }
 
+    /// The settings of `radiosity solve`: without `--error`, the library's default error
+    /// policy ([`SolveSettings::with_solve_default_error`]).
+    pub fn solve_settings(&self) -> SolveSettings {
+        let s = self.settings();
+        match self.error_target {
+            None => s.with_solve_default_error(),
+            Some(_) => s,
+        }
+    }
+
     pub fn intersector(&self) -> IntersectorKind {
-        self.sampling.intersector.into()
+        self.sampling.intersector
     }
 }
 
@@ -335,7 +307,7 @@ pub struct ShadingArgs {
     /// gouraud: the solution's patches interpolated at their vertices, the fast preview
     /// [default: gather for render and relight, gouraud for solve]
     #[arg(long, value_enum)]
-    pub shading: Option<ShadingArg>,
+    pub shading: Option<Shading>,
     /// --shading gather: rays gathered per anti-aliasing sample (half to the lights, the rest
     /// over the hemisphere); --supersample sets the samples per pixel.
     #[arg(long, default_value_t = DEFAULT_PIXEL_RAYS, value_name = "N")]
@@ -352,26 +324,10 @@ impl ShadingArgs {
     /// `--shading` is left out (the command's own).
     pub fn settings(&self, seed: u64, default: Shading) -> ShadingSettings {
         ShadingSettings {
-            shading: self.shading.map_or(default, Shading::from),
+            shading: self.shading.unwrap_or(default),
             rays: self.pixel_rays,
             seed,
             indirect_spacing: self.indirect_spacing,
-        }
-    }
-}
-
-/// `--shading`: see `radiosity::render::Shading`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum ShadingArg {
-    Gather,
-    Gouraud,
-}
-
-impl From<ShadingArg> for Shading {
-    fn from(s: ShadingArg) -> Shading {
-        match s {
-            ShadingArg::Gather => Shading::Gather,
-            ShadingArg::Gouraud => Shading::Gouraud,
         }
     }
 }
@@ -396,74 +352,6 @@ impl CheckArgs {
             patch_size: self.check_patch_size,
             two_sided: None,
         })
-    }
-}
-
-/// `--intersector`: see `radiosity::intersect::select::IntersectorKind`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum IntersectorArg {
-    Auto,
-    Embree,
-    Merge,
-    Hybrid,
-}
-
-impl From<IntersectorArg> for IntersectorKind {
-    fn from(a: IntersectorArg) -> IntersectorKind {
-        match a {
-            IntersectorArg::Auto => IntersectorKind::Auto,
-            IntersectorArg::Embree => IntersectorKind::Embree,
-            IntersectorArg::Merge => IntersectorKind::Merge,
-            IntersectorArg::Hybrid => IntersectorKind::Hybrid,
-        }
-    }
-}
-
-/// `--method`: see `radiosity::solve::MethodKind`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum Method {
-    /// Shooting with the paper's adaptive polar hemisphere ray sampler (Sec. 2).
-    AdaptiveRays,
-    /// Shooting with the uniform N×N hemi-cube (Cohen & Greenberg 1985): the baseline.
-    Hemicube,
-    /// The uniform hemi-cube with jittered sample points (the paper's Table 1).
-    HemicubeJittered,
-    /// Shooting with the paper's non-uniform hemi-cube, resolution from the unshot energy.
-    AdaptiveHemicube,
-    /// Adaptive hemi-cube first, adaptive rays once cheaper by the cost model (Sec. 4).
-    AdaptiveHybrid,
-    /// The traditional algorithm: full form-factor matrix, then Gauss–Seidel.
-    Gathering,
-}
-
-impl From<Method> for MethodKind {
-    fn from(m: Method) -> MethodKind {
-        match m {
-            Method::AdaptiveRays => MethodKind::AdaptiveRays,
-            Method::Hemicube => MethodKind::Hemicube,
-            Method::HemicubeJittered => MethodKind::HemicubeJittered,
-            Method::AdaptiveHemicube => MethodKind::AdaptiveHemicube,
-            Method::AdaptiveHybrid => MethodKind::AdaptiveHybrid,
-            Method::Gathering => MethodKind::Gathering,
-        }
-    }
-}
-
-/// `--light-groups`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum LightGroupsArg {
-    /// One channel per emitting material.
-    Material,
-    /// One channel per connected emitting surface (fixtures of one material apart).
-    Connected,
-}
-
-impl From<LightGroupsArg> for GroupBy {
-    fn from(a: LightGroupsArg) -> Self {
-        match a {
-            LightGroupsArg::Material => GroupBy::Material,
-            LightGroupsArg::Connected => GroupBy::Connected,
-        }
     }
 }
 
@@ -550,4 +438,20 @@ pub fn parse_weight(s: &str) -> Result<(String, f64), String> {
         return Err(format!("the weight in '{s}' must be a finite number ≥ 0"));
     }
     Ok((name.trim().to_string(), w))
+}
+
+/// A direction flag's value X,Y,Z, shown in `--help` as it is typed (`0,1,0`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Xyz(pub Vec3);
+
+impl Xyz {
+    pub fn parse(s: &str) -> Result<Xyz, String> {
+        parse_vec3(s).map(Xyz)
+    }
+}
+
+impl std::fmt::Display for Xyz {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{},{},{}", self.0.x, self.0.y, self.0.z)
+    }
 }

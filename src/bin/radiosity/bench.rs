@@ -1,12 +1,21 @@
 //! Benchmarks and cross-checks: `radiosity bench …`, `radiosity crosscheck`, `radiosity sweep`.
 
-use crate::args::{parse_sizes, source, Method, SceneArgs, Sizes, SolverArgs};
+use super::args::{parse_sizes, source, SceneArgs, Sizes, SolverArgs};
 use crate::{out, outln};
 use clap::{Args, Subcommand};
-use radiosity::bench::crosscheck::RaySource;
-use radiosity::bench::intersect::{self as intersect_jobs, BenchJob, CrossJob};
+use radiosity::bench::elements::{
+    ElementBenchJob, DEFAULT_REFERENCE_RAYS, DEFAULT_TESTS, DEFAULT_THRESHOLDS,
+};
+use radiosity::bench::intersect::{self as intersect_jobs, BenchJob, CrossJob, RaysFrom};
+use radiosity::bench::intersect::{
+    DEFAULT_BENCH_RAYS, DEFAULT_EPS, DEFAULT_GENERATED, DEFAULT_SEED,
+};
+use radiosity::bench::rays::{RaysJob, DEFAULT_MIN_SECONDS, DEFAULT_RAW_RAYS};
+use radiosity::bench::shots::{ShotsJob, DEFAULT_RESOLUTIONS, DEFAULT_SHOOTERS};
 use radiosity::bench::{intersect_table, rays, sweep};
+use radiosity::elements::Test;
 use radiosity::export::write_atomic;
+use radiosity::generate::BuildingOptions;
 use radiosity::scene::SceneSource;
 use radiosity::solve::MethodKind;
 
@@ -23,17 +32,17 @@ pub enum BenchCommand {
         scene_args: SceneArgs,
         /// Generated buildings of about these many patches (1k = 1000, 1M = 1000000; "none"
         /// for none). 1M takes minutes and a few GB.
-        #[arg(long, value_parser = parse_sizes, default_value = "1k,10k,100k")]
+        #[arg(long, value_parser = parse_sizes, default_value = DEFAULT_GENERATED)]
         generated: Sizes,
         /// Rays per intersector and scene (brute force casts fewer).
-        #[arg(long, default_value_t = 1_000_000)]
+        #[arg(long, default_value_t = DEFAULT_BENCH_RAYS)]
         rays: u64,
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = DEFAULT_SEED)]
         seed: u64,
         /// Which rays: from patch surfaces as the solver casts them, uniform (origin in the
         /// bounds, direction on the sphere), or half of each.
-        #[arg(long, value_enum, default_value_t = RaysArg::Both)]
-        source: RaysArg,
+        #[arg(long, value_enum, default_value_t = RaysFrom::default())]
+        source: RaysFrom,
         /// Also write the table as CSV to this file.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -47,11 +56,11 @@ pub enum BenchCommand {
         #[command(flatten)]
         solve_args: SolverArgs,
         /// Random rays for the raw measurement (a quarter before each solve).
-        #[arg(long, default_value_t = 4_000_000)]
+        #[arg(long, default_value_t = DEFAULT_RAW_RAYS)]
         rays: u64,
         /// Solve again (next seeds) until the solves took this long in all, alternating with
         /// raw measurements, so both see the same machine.
-        #[arg(long, default_value_t = 3.0, value_name = "SECONDS")]
+        #[arg(long, default_value_t = DEFAULT_MIN_SECONDS, value_name = "SECONDS")]
         min_seconds: f64,
         /// Also write the figures as JSON to this file.
         #[arg(long)]
@@ -66,10 +75,10 @@ pub enum BenchCommand {
         #[command(flatten)]
         solve_args: SolverArgs,
         /// Uniform hemi-cube resolutions to compare.
-        #[arg(long, value_delimiter = ',', default_value = "25,50,100,200")]
+        #[arg(long, value_delimiter = ',', default_value = DEFAULT_RESOLUTIONS)]
         resolutions: Vec<usize>,
         /// Patches to shoot from (spread over the scene), the same for every sampler.
-        #[arg(long, default_value_t = 64)]
+        #[arg(long, default_value_t = DEFAULT_SHOOTERS)]
         shooters: usize,
         /// Also write the figures as JSON to this file.
         #[arg(long)]
@@ -85,20 +94,11 @@ pub enum BenchCommand {
         #[command(flatten)]
         solve_args: SolverArgs,
         /// Thresholds of the adaptive meshes (--element-threshold).
-        #[arg(
-            long,
-            value_delimiter = ',',
-            default_value = "0.005,0.01,0.02,0.04,0.08"
-        )]
+        #[arg(long, value_delimiter = ',', default_value = DEFAULT_THRESHOLDS)]
         thresholds: Vec<f64>,
         /// What the thresholds apply to (--element-test), each measured.
-        #[arg(
-            long,
-            value_enum,
-            value_delimiter = ',',
-            default_value = "halves,midpoints"
-        )]
-        tests: Vec<crate::solve::ElementTestArg>,
+        #[arg(long, value_enum, value_delimiter = ',', default_value = DEFAULT_TESTS)]
+        tests: Vec<Test>,
         /// Differences below this fraction of the scene's mean radiosity count as if at it.
         #[arg(long, default_value_t = radiosity::elements::FLOOR)]
         floor: f64,
@@ -109,20 +109,12 @@ pub enum BenchCommand {
         #[arg(long, default_value_t = radiosity::elements::DEFAULT_RAYS)]
         element_rays: usize,
         /// Rays per corner of the reference.
-        #[arg(long, default_value_t = 2048)]
+        #[arg(long, default_value_t = DEFAULT_REFERENCE_RAYS)]
         reference_rays: usize,
         /// Also write the figures as JSON to this file.
         #[arg(long)]
         out: Option<PathBuf>,
     },
-}
-
-/// `bench intersect --source`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum RaysArg {
-    Both,
-    Surface,
-    Uniform,
 }
 
 #[derive(Args)]
@@ -134,11 +126,11 @@ pub struct CrosscheckArgs {
     /// Rays to cast (half from patch surfaces as the solver casts them, half uniform).
     #[arg(long)]
     rays: u64,
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = DEFAULT_SEED)]
     seed: u64,
     /// Edge distance, relative to the scene's diagonal, within which a disagreement counts as
     /// crossing a patch edge.
-    #[arg(long, default_value_t = 1e-5, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = DEFAULT_EPS, allow_negative_numbers = true)]
     eps: f32,
     /// The scene is open: rays escaping it do not fail the bar (default: judged by the
     /// reference's escapes).
@@ -167,14 +159,14 @@ pub struct SweepArgs {
         value_delimiter = ',',
         default_value = "adaptive-hybrid"
     )]
-    methods: Vec<Method>,
+    methods: Vec<MethodKind>,
     #[command(flatten)]
     solve_args: SolverArgs,
     /// Output folder (sweep.csv, sweep.md, time.png, memory.png).
     #[arg(long)]
     out: PathBuf,
     /// Seed of the generated buildings.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = BuildingOptions::default().seed)]
     building_seed: u64,
 }
 
@@ -196,11 +188,7 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
                 mesh: scene_args.mesh(),
                 rays,
                 seed,
-                rays_from: match rays_from {
-                    RaysArg::Both => None,
-                    RaysArg::Surface => Some(RaySource::Surface),
-                    RaysArg::Uniform => Some(RaySource::Uniform),
-                },
+                rays_from,
             };
             let rows = intersect_jobs::bench_intersect(&job, |r| {
                 eprintln!(
@@ -223,15 +211,15 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
             min_seconds,
             out,
         } => {
-            let b = rays::bench_rays(
-                &source(scene),
-                &scene_args.load(),
-                &scene_args.mesh(),
-                &solve_args.settings(),
-                solve_args.intersector(),
-                rays,
+            let b = rays::bench_rays(&RaysJob {
+                source: source(scene),
+                load: scene_args.load(),
+                mesh: scene_args.mesh(),
+                solve: solve_args.settings(),
+                intersector: solve_args.intersector(),
+                raw_rays: rays,
                 min_seconds,
-            )?;
+            })?;
             outln!("{}", b.text());
             if let Some(path) = out {
                 write_json(&path, &b)?;
@@ -246,19 +234,14 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
             shooters,
             out,
         } => {
-            if let Some(&bad) = resolutions.iter().find(|&&n| !(2..=4096).contains(&n)) {
-                return Err(radiosity::Error::Invalid(format!(
-                    "--resolutions must be between 2 and 4096, got {bad}"
-                )));
-            }
-            let b = radiosity::bench::shots::bench_shots(
-                &source(scene),
-                &scene_args.load(),
-                &scene_args.mesh(),
-                &solve_args.settings(),
-                &resolutions,
+            let b = radiosity::bench::shots::bench_shots(&ShotsJob {
+                source: source(scene),
+                load: scene_args.load(),
+                mesh: scene_args.mesh(),
+                solve: solve_args.settings(),
+                resolutions,
                 shooters,
-            )?;
+            })?;
             out!("{}", b.markdown());
             if let Some(path) = out {
                 write_json(&path, &b)?;
@@ -277,10 +260,10 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
             reference_rays,
             out,
         } => {
-            let job = radiosity::bench::elements::ElementBenchJob {
+            let job = ElementBenchJob {
                 solve: solve_args.settings(),
                 thresholds,
-                tests: tests.into_iter().map(Into::into).collect(),
+                tests,
                 floor,
                 min_size: element_min_size,
                 rays: element_rays,
@@ -294,20 +277,10 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
 fn bench_elements(
     scene: Option<PathBuf>,
     scene_args: SceneArgs,
-    job: radiosity::bench::elements::ElementBenchJob,
+    job: ElementBenchJob,
     out: Option<PathBuf>,
 ) -> Result<(), radiosity::Error> {
-    radiosity::elements::ElementSettings {
-        min_size: job.min_size,
-        rays: job.rays.max(job.reference_rays.min(2)),
-        ..Default::default()
-    }
-    .check()?;
-    if job.thresholds.iter().any(|t| !(*t > 0.0 && t.is_finite())) || job.reference_rays < 2 {
-        return Err(radiosity::Error::Invalid(
-            "--thresholds must be positive fractions and --reference-rays at least 2".into(),
-        ));
-    }
+    job.check()?;
     let model =
         radiosity::model::Model::load(&source(scene), &scene_args.load(), &scene_args.mesh())?;
     let r = radiosity::bench::elements::run(&model, &job, &mut |l: &str| eprintln!("{l}"))?;
@@ -329,7 +302,7 @@ fn write_json(path: &std::path::Path, v: &impl serde::Serialize) -> Result<(), r
 pub fn sweep(a: SweepArgs) -> Result<(), radiosity::Error> {
     let job = sweep::SweepJob {
         sizes: a.sizes.0.clone(),
-        methods: a.methods.iter().copied().map(MethodKind::from).collect(),
+        methods: a.methods.clone(),
         cfg: a.solve_args.settings(),
         intersector: a.solve_args.intersector(),
         out: a.out.clone(),

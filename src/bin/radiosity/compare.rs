@@ -1,6 +1,6 @@
 //! `radiosity reference` and `radiosity compare`: the paper's error and speed analyses.
 
-use crate::args::{source, Method, SamplingArgs, SceneArgs};
+use super::args::{source, SamplingArgs, SceneArgs};
 use crate::out;
 use clap::Args;
 use radiosity::compare::{self, CompareJob, ReferenceJob};
@@ -34,7 +34,7 @@ pub struct CompareArgs {
         value_delimiter = ',',
         default_value = "adaptive-hybrid,adaptive-rays,adaptive-hemicube,hemicube,hemicube-jittered,gathering"
     )]
-    methods: Vec<Method>,
+    methods: Vec<MethodKind>,
     /// Time budget per method in seconds (gathering always finishes its matrix).
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     budget: f64,
@@ -74,7 +74,7 @@ pub fn reference(a: ReferenceArgs) -> Result<(), radiosity::Error> {
         load: a.scene_args.load(),
         mesh: a.scene_args.mesh(),
         solve: a.sampling.over(SolveSettings::reference(1)),
-        intersector: a.sampling.intersector.into(),
+        intersector: a.sampling.intersector,
         out: a.out,
     };
     compare::run_reference(&job, |line| eprintln!("{line}")).map(|_| ())
@@ -86,7 +86,7 @@ pub fn compare(a: CompareArgs) -> Result<(), radiosity::Error> {
         source: source(a.scene),
         load: a.scene_args.load(),
         mesh: a.scene_args.mesh(),
-        methods: a.methods.into_iter().map(MethodKind::from).collect(),
+        methods: a.methods,
         budget: a.budget,
         reference: a.reference,
         reference_solve: SolveSettings {
@@ -95,7 +95,7 @@ pub fn compare(a: CompareArgs) -> Result<(), radiosity::Error> {
             ..SolveSettings::reference(solve.seed.wrapping_add(1_000_003))
         },
         solve,
-        intersector: a.sampling.intersector.into(),
+        intersector: a.sampling.intersector,
         levels: a.levels,
         repeat: a.repeat,
         out: a.out.clone(),

@@ -8,6 +8,11 @@
 //! - `bench`: `bench intersect|rays|shots`, `crosscheck`, `sweep`;
 //! - `scene`: `info`, `generate`;
 //! - `args`: the flag groups they share.
+//!
+//! The modules name each other through `super::`, never `crate::` (the macros below aside, which
+//! `#[macro_export]` puts at the root of whichever crate compiles them): tests/settings_parity.rs
+//! compiles this whole command line as a module of its own, to walk clap's own argument list
+//! and to parse flags into the jobs without running them.
 
 mod args;
 mod bench;
@@ -49,16 +54,16 @@ macro_rules! out {
     version,
     about = "Adaptive progressive-refinement radiosity (Airey & Ouh-young 1989) for architectural models"
 )]
-struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
-    command: Command,
+    pub(crate) command: Command,
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, global = true, value_parser = args::parse_threads)]
-    threads: Option<usize>,
+    pub(crate) threads: Option<usize>,
 }
 
 #[derive(Subcommand)]
-enum Command {
+pub(crate) enum Command {
     /// Solve a scene and write patches.csv, render.png and summary.json into --out.
     Solve(Box<solve::SolveArgs>),
     /// Describe a scene: polygons, patches, axis-aligned share, materials, lights, bounds.

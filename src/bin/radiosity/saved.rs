@@ -1,6 +1,6 @@
 //! The commands that act on a saved solution (`solve --save`): `render`, `export`, `relight`.
 
-use crate::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs};
+use super::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs};
 use crate::outln;
 use clap::Args;
 use radiosity::progress::Progress;
@@ -24,7 +24,7 @@ pub struct RenderArgs {
     shading: ShadingArgs,
     /// Seed of the gathered picture's random numbers; the same seed gives the same image on
     /// any thread count.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = radiosity::solve::settings::DEFAULT_SEED)]
     seed: u64,
     /// Irradiance in false colour on a log scale, with a legend in W/m² (PNG only).
     #[arg(long, alias = "false-color")]

@@ -1,6 +1,6 @@
 //! `radiosity info` (describe a scene) and `radiosity generate` (write a model).
 
-use crate::args::{source, SceneArgs};
+use super::args::{source, SceneArgs};
 use crate::{out, outln};
 use clap::{Args, Subcommand};
 use radiosity::generate::{self, BuildingOptions, BUILDING_PATCH_SIZE};
@@ -24,15 +24,15 @@ pub enum GenerateCommand {
         /// The OBJ file to write.
         #[arg(long)]
         out: PathBuf,
-        #[arg(long, default_value_t = 3)]
+        #[arg(long, default_value_t = BuildingOptions::default().floors)]
         floors: u32,
         /// Rooms per floor.
-        #[arg(long, default_value_t = 8)]
+        #[arg(long, default_value_t = BuildingOptions::default().rooms_per_floor)]
         rooms: u32,
         /// Aim at about this many patches (overrides --floors and --rooms).
         #[arg(long)]
         patches: Option<usize>,
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = BuildingOptions::default().seed)]
         seed: u64,
     },
 }

@@ -1,13 +1,13 @@
-//! The daylight flags (issue 14): which sky, how bright, where the sun is, which way is up and
-//! north. Parsed here; checked by the library ([`radiosity::sky::Sky::new`]), so a bad value
-//! is one line naming the flag and a non-zero exit.
+//! The daylight flags: which sky, how bright, where the sun is, which way is up and north.
+//! Parsed here into the library's [`SkySettings`], which checks them
+//! ([`SkySettings::check`]) before any model is read, so a bad value is one line naming the
+//! flag and exit code 2.
 
-use crate::args::{parse_floats, parse_vec3};
+use super::args::{parse_floats, parse_vec3, Xyz};
 use clap::Args;
 use glam::Vec3;
 use radiosity::sky::{
-    DateTime, Site, SkyKind, SkyLevel, SkySpec, SolarAngles, SunLevel, DEFAULT_GROUND_REFLECTANCE,
-    DEFAULT_SKY_ILLUMINANCE,
+    SkyKind, SkySettings, SunSetting, DEFAULT_GROUND_REFLECTANCE, DEFAULT_ZENITH,
 };
 
 /// Daylight: a sky (and sun) that lights the model from outside.
@@ -17,33 +17,40 @@ pub struct SkyArgs {
     /// sky, the CIE clear sky (needs --sun), or a uniform sky; the ground below the horizon
     /// glows with --ground-reflectance.
     #[arg(long, value_enum, value_name = "overcast|clear|uniform")]
-    pub sky: Option<SkyArg>,
+    pub sky: Option<SkyKind>,
     /// The sky's unobstructed horizontal illuminance without the sun, lux [default: 10000 for
     /// overcast and uniform; gensky's value from the sun's altitude for clear].
-    #[arg(long, value_name = "LUX")]
+    #[arg(long, value_name = "LUX", allow_negative_numbers = true)]
     pub sky_illuminance: Option<f64>,
     /// The sky's zenith luminance, cd/m² (gensky -b × 179), instead of --sky-illuminance.
-    #[arg(long, value_name = "CD_M2", conflicts_with = "sky_illuminance")]
+    #[arg(
+        long,
+        value_name = "CD_M2",
+        conflicts_with = "sky_illuminance",
+        allow_negative_numbers = true
+    )]
     pub zenith_luminance: Option<f64>,
     /// A sun: ALT,AZI in degrees (azimuth west of south, as gensky -ang), or a local time
     /// such as 2026-06-21T12:00+02:00 (with --site), or off.
     #[arg(long, value_name = "ALT,AZI|TIME|off", value_parser = parse_sun, allow_hyphen_values = true)]
-    pub sun: Option<SunArg>,
+    pub sun: Option<SunSetting>,
     /// Where the model stands, for --sun TIME: LAT,LON in degrees (north and east positive).
     #[arg(long, value_name = "LAT,LON", value_parser = parse_pair, allow_hyphen_values = true)]
     pub site: Option<(f64, f64)>,
     /// The sun's direct normal illuminance, lux [default: gensky's clear-sky sun].
-    #[arg(long, value_name = "LUX")]
+    #[arg(long, value_name = "LUX", allow_negative_numbers = true)]
     pub sun_illuminance: Option<f64>,
     /// Reflectance of the ground outside the model, which glows below the horizon.
-    #[arg(long, default_value_t = DEFAULT_GROUND_REFLECTANCE, value_name = "RHO")]
+    #[arg(long, default_value_t = DEFAULT_GROUND_REFLECTANCE, value_name = "RHO", allow_negative_numbers = true)]
     pub ground_reflectance: f64,
     /// The model's up direction X,Y,Z.
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,1,0")]
-    pub zenith: Vec3,
-    /// The model's north X,Y,Z (its horizontal part counts).
-    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,-1")]
-    pub north: Vec3,
+    #[arg(long, value_parser = Xyz::parse, allow_hyphen_values = true, default_value_t = Xyz(DEFAULT_ZENITH))]
+    pub zenith: Xyz,
+    /// The model's north X,Y,Z (its horizontal part counts) [default: 0,0,-1 with the default
+    /// zenith, 0,1,0 with --zenith 0,0,1 (Radiance's convention); in general −Z turned by the
+    /// shortest rotation from +Y to the zenith].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub north: Option<Vec3>,
     /// Illuminance sensors: HEIGHT,SPACING in metres (a work plane above each floor: an
     /// upward surface with at least 2.3 m clear above it), or a CSV file of points with
     /// columns x,y,z,nx,ny,nz. Writes grid.csv (x,y,z,nx,ny,nz,lux,df), the plan grid.png,
@@ -55,85 +62,27 @@ pub struct SkyArgs {
     pub grid_rays: usize,
 }
 
-/// `--sky`.
-#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SkyArg {
-    Overcast,
-    Clear,
-    Uniform,
-}
-
-/// `--sun`.
-#[derive(Clone, Debug, PartialEq)]
-pub enum SunArg {
-    Off,
-    Angles(f64, f64),
-    Time(DateTime),
-}
-
-fn parse_sun(s: &str) -> Result<SunArg, String> {
-    if s == "off" || s == "none" {
-        return Ok(SunArg::Off);
+impl SkyArgs {
+    /// The daylight flags as the library's settings (checked there: [`SkySettings::check`]).
+    pub fn settings(&self) -> SkySettings {
+        SkySettings {
+            kind: self.sky,
+            sky_illuminance: self.sky_illuminance,
+            zenith_luminance: self.zenith_luminance,
+            sun: self.sun,
+            site: self.site,
+            sun_illuminance: self.sun_illuminance,
+            ground_reflectance: self.ground_reflectance,
+            zenith: self.zenith.0,
+            north: self.north,
+        }
     }
-    if let Ok((alt, azi)) = parse_pair(s) {
-        return Ok(SunArg::Angles(alt, azi));
-    }
-    s.parse::<DateTime>().map(SunArg::Time).map_err(|e| {
-        format!("expected ALT,AZI in degrees, a time such as 2026-06-21T12:00+02:00, or off ({e})")
-    })
 }
 
 fn parse_pair(s: &str) -> Result<(f64, f64), String> {
     parse_floats::<2>(s).map(|[a, b]| (a, b))
 }
 
-impl SkyArgs {
-    /// The sky asked for, unchecked (the solver checks it: `radiosity::sky::Sky::new`), or
-    /// `Err` naming the flags when the sun's time has no --site.
-    pub fn spec(&self) -> Result<Option<SkySpec>, String> {
-        let Some(kind) = self.sky else {
-            if self.sun.as_ref().is_some_and(|s| *s != SunArg::Off) {
-                return Err("--sun needs --sky overcast|clear|uniform".into());
-            }
-            return Ok(None);
-        };
-        let kind = match kind {
-            SkyArg::Overcast => SkyKind::Overcast,
-            SkyArg::Clear => SkyKind::Clear,
-            SkyArg::Uniform => SkyKind::Uniform,
-        };
-        let sun_position = match &self.sun {
-            None | Some(SunArg::Off) => None,
-            Some(SunArg::Angles(alt, azi)) => {
-                Some(SolarAngles::new(*alt, *azi).map_err(|e| format!("--sun: {e}"))?)
-            }
-            Some(SunArg::Time(t)) => {
-                let (lat, lon) = self
-                    .site
-                    .ok_or("--sun TIME needs --site LAT,LON (degrees, north and east positive)")?;
-                let site = Site::new(lat, lon).map_err(|e| format!("--site: {e}"))?;
-                t.validate().map_err(|e| format!("--sun: {e}"))?;
-                Some(SolarAngles::at(&site, t))
-            }
-        };
-        let level = match (self.sky_illuminance, self.zenith_luminance, kind) {
-            (Some(lux), _, _) => SkyLevel::HorizontalIlluminance(lux),
-            (None, Some(cd), _) => SkyLevel::ZenithLuminance(cd),
-            (None, None, SkyKind::Clear) => SkyLevel::Gensky,
-            (None, None, _) => SkyLevel::HorizontalIlluminance(DEFAULT_SKY_ILLUMINANCE),
-        };
-        let sun = sun_position.map(|_| {
-            self.sun_illuminance
-                .map_or(SunLevel::Gensky, SunLevel::NormalIlluminance)
-        });
-        Ok(Some(SkySpec {
-            kind,
-            level,
-            sun_position,
-            sun,
-            ground_reflectance: self.ground_reflectance,
-            zenith: self.zenith,
-            north: self.north,
-        }))
-    }
+fn parse_sun(s: &str) -> Result<SunSetting, String> {
+    s.parse().map_err(|e: radiosity::settings::Invalid| e.0)
 }

@@ -1,12 +1,14 @@
 //! `radiosity solve`.
 
-use crate::args::{source, LightGroupsArg, SceneArgs, ShadingArgs, SolverArgs, ViewArgs};
-use crate::sky_args::SkyArgs;
-use crate::{interrupt_flag, outln};
+use super::args::{source, SceneArgs, ShadingArgs, SolverArgs, ViewArgs};
+use super::interrupt_flag;
+use super::sky_args::SkyArgs;
+use crate::outln;
 use clap::Args;
 use radiosity::elements;
 use radiosity::pipeline::{self, RunSettings, SolveJob, DEFAULT_CHECKPOINT_EVERY};
 use radiosity::progress::Progress;
+use radiosity::solve::lights::GroupBy;
 use radiosity::solve::StopReason;
 use std::path::PathBuf;
 
@@ -63,8 +65,8 @@ pub struct SolveArgs {
     #[arg(long, value_name = "FILE")]
     resume: Option<PathBuf>,
     /// With --per-light: one channel per emitting material, or per connected emitting surface.
-    #[arg(long, value_enum, default_value_t = LightGroupsArg::Material, requires = "per_light")]
-    light_groups: LightGroupsArg,
+    #[arg(long, value_enum, default_value_t = GroupBy::default(), requires = "per_light")]
+    light_groups: GroupBy,
 }
 
 /// Adaptive elements (Cohen et al. 1986): patches shoot, elements receive.
@@ -96,8 +98,8 @@ pub struct ElementArgs {
     /// picture's error; a quad cut in two across the direction the light changes along),
     /// midpoints (the same test, cut in four) or corners (Cohen et al. 1986: the difference
     /// between its corners, cut in four).
-    #[arg(long, value_enum, default_value_t = ElementTestArg::Halves)]
-    element_test: ElementTestArg,
+    #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().test)]
+    element_test: elements::Test,
 }
 
 /// `--elements`.
@@ -106,24 +108,6 @@ pub enum ElementsArg {
     Auto,
     On,
     Off,
-}
-
-/// `--element-test`: see `radiosity::elements::Test`.
-#[derive(Clone, Copy, clap::ValueEnum)]
-pub enum ElementTestArg {
-    Midpoints,
-    Corners,
-    Halves,
-}
-
-impl From<ElementTestArg> for elements::Test {
-    fn from(a: ElementTestArg) -> elements::Test {
-        match a {
-            ElementTestArg::Midpoints => elements::Test::Midpoints,
-            ElementTestArg::Corners => elements::Test::Corners,
-            ElementTestArg::Halves => elements::Test::Halves,
-        }
-    }
 }
 
 impl ElementArgs {
@@ -135,43 +119,57 @@ impl ElementArgs {
             min_size: self.element_min_size,
             rays: self.element_rays,
             max_factor: self.element_max,
-            test: self.element_test.into(),
+            test: self.element_test,
         }
     }
 }
 
+impl SolveArgs {
+    /// The job these flags ask for, its sky checked (before any model is read; the rest of the
+    /// settings are checked by the job: [`SolveJob::check`]).
+    pub fn job(&self) -> Result<SolveJob, radiosity::Error> {
+        let sky = self.sky.settings();
+        let solve = radiosity::solve::SolveSettings {
+            sky: sky.spec()?,
+            ..self.solve_args.solve_settings()
+        };
+        let (zenith, north) = sky.directions();
+        let solve_seed = solve.seed;
+        Ok(SolveJob {
+            source: source(self.scene.clone()),
+            settings: RunSettings {
+                load: self.scene_args.load(),
+                mesh: self.scene_args.mesh(),
+                solve,
+                intersector: self.solve_args.intersector(),
+                per_light: self.per_light.then_some(self.light_groups),
+                elements: self.elements.settings(),
+            },
+            view: self.view.settings()?,
+            out: self.out.clone(),
+            reference: self.reference.clone(),
+            save: self.save.clone(),
+            checkpoint: self.checkpoint.clone(),
+            checkpoint_every: self.checkpoint_every,
+            resume: self.resume.clone(),
+            interrupt: None,
+            grid: self.sky.grid.clone(),
+            grid_rays: self.sky.grid_rays,
+            zenith,
+            north,
+            shading: self
+                .shading
+                .settings(solve_seed, radiosity::render::Shading::Gouraud),
+        })
+    }
+}
+
 pub fn run(a: SolveArgs) -> Result<(), radiosity::Error> {
-    let solve = radiosity::solve::SolveSettings {
-        sky: a.sky.spec().map_err(radiosity::Error::Invalid)?,
-        ..a.solve_args.solve_settings()
-    };
-    let solve_seed = solve.seed;
     let job = SolveJob {
-        source: source(a.scene),
-        settings: RunSettings {
-            load: a.scene_args.load(),
-            mesh: a.scene_args.mesh(),
-            solve,
-            intersector: a.solve_args.intersector(),
-            per_light: a.per_light.then_some(a.light_groups.into()),
-            elements: a.elements.settings(),
-        },
-        view: a.view.settings()?,
-        out: a.out.clone(),
-        reference: a.reference,
-        save: a.save.clone(),
-        checkpoint: a.checkpoint.clone(),
-        checkpoint_every: a.checkpoint_every,
-        resume: a.resume,
         interrupt: Some(interrupt_flag()),
-        grid: a.sky.grid.clone(),
-        grid_rays: a.sky.grid_rays,
-        zenith: a.sky.zenith,
-        north: a.sky.north,
-        shading: a
-            .shading
-            .settings(solve_seed, radiosity::render::Shading::Gouraud),
+        ..a.job()?
     };
+    job.check()?;
     let quiet = a.quiet || a.json;
     let progress = Progress::for_terminal(quiet);
     let summary = pipeline::run_solve_with(&job, &progress, |line| {
