@@ -91,4 +91,14 @@ impl Model {
             source,
         })
     }
+
+    /// Scalar flux the lights emit (W): what a solve's progress is measured against.
+    pub fn emitted_flux(&self) -> f64 {
+        let materials = &self.scene.materials;
+        self.mesh
+            .patches
+            .iter()
+            .map(|p| solve::scalar(&materials[p.material as usize].emission()) * p.area)
+            .sum()
+    }
 }

@@ -32,18 +32,3 @@ impl Invalid {
 /// mean): for the library enums whose variant docs are written for the code, not the user.
 /// `#[value(help = NO_HELP)]` on a `clap::ValueEnum` variant.
 pub const NO_HELP: Option<&str> = None;
-
-/// `--shading gather|gouraud`. Written out, not derived: [`crate::render::Shading`] lives with
-/// the renderer, and its flag spelling is its [`name`](crate::render::Shading::name).
-impl clap::ValueEnum for crate::render::Shading {
-    fn value_variants<'a>() -> &'a [Self] {
-        &[
-            crate::render::Shading::Gather,
-            crate::render::Shading::Gouraud,
-        ]
-    }
-
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.name()))
-    }
-}

@@ -251,17 +251,6 @@ fn write_png(path: &std::path::Path, img: &image::RgbImage) -> Result<(), Error>
     Ok(())
 }
 
-/// Scalar flux the lights emit (W): what the solve's progress is measured against.
-pub fn emitted_flux(model: &Model) -> f64 {
-    let materials = &model.scene.materials;
-    model
-        .mesh
-        .patches
-        .iter()
-        .map(|p| solve::scalar(&materials[p.material as usize].emission()) * p.area)
-        .sum()
-}
-
 /// Refuses a `--save` path that cannot be written, before any work is spent.
 pub fn check_save_path(path: &std::path::Path) -> Result<(), Error> {
     if path.is_dir() {

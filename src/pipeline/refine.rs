@@ -6,18 +6,12 @@ use super::stages::Solved;
 use super::SolveJob;
 use crate::elements::{self, ElementStats, Elements};
 use crate::intersect::select::AnyIntersector;
-use crate::mesh::Mesh;
 
 /// What the refine stage made: `elements.csv`, the Gouraud picture and the saved solution read
 /// the elements; `summary.json` the statistics (`None` when nothing was refined).
 pub struct Refined {
     pub elements: Elements,
     pub stats: Option<ElementStats>,
-}
-
-/// Whether the job's elements are refined on `mesh` (`--elements auto` skips large meshes).
-pub fn applies(job: &SolveJob, mesh: &Mesh) -> bool {
-    job.settings.elements.applies_to(mesh.patches.len())
 }
 
 /// Refine: the elements of `solved`, gathering through `isect` (`None` only when nothing is
@@ -31,7 +25,7 @@ pub fn refine(
 ) -> Refined {
     let (scene, m) = (&solved.model.scene, &solved.model.mesh);
     let sol = &solved.sol;
-    let wanted = applies(job, m);
+    let wanted = job.settings.elements.applies_to(m.patches.len());
     if job.settings.elements.enabled && !wanted {
         log(&format!(
             "elements: skipped for {} patches (--elements auto refines up to {}; --elements on to refine anyway)",

@@ -3,7 +3,7 @@
 //! user should hear of, and returns its value; `solve_into` (`super`) calls them in order. What
 //! follows the solve reads it through [`Solved`].
 
-use super::{outputs, SolveJob};
+use super::SolveJob;
 use crate::intersect::select::{AnyIntersector, Selection};
 use crate::intersect::Intersector;
 use crate::model::Model;
@@ -130,7 +130,7 @@ pub fn solve(
     progress: &Progress,
     log: &mut impl FnMut(&str),
 ) -> Result<Solution, Error> {
-    progress.start_solve(outputs::emitted_flux(model));
+    progress.start_solve(model.emitted_flux());
     let sol = model.solve(
         isect.map(|(i, _)| i),
         &job.settings.solve,
@@ -155,7 +155,10 @@ impl Solved<'_> {
     /// The intersector of the stages after the solve that cast rays (the elements, the gathered
     /// picture): the solve's, or one built for them when they need rays and the method cast none.
     pub fn intersector_after(&self, job: &SolveJob) -> Result<Option<AnyIntersector>, Error> {
-        let needs_rays = super::refine::applies(job, &self.model.mesh)
+        let needs_rays = job
+            .settings
+            .elements
+            .applies_to(self.model.mesh.patches.len())
             || job.shading.shading == crate::render::Shading::Gather;
         if self.isect.is_none() && needs_rays {
             Ok(Some(self.model.intersector(job.settings.intersector)?.0))

@@ -88,6 +88,18 @@ pub enum Shading {
     Gather,
 }
 
+/// `--shading gather|gouraud`, written out so that `--help` lists `gather` first and each
+/// value's spelling is [`Shading::name`].
+impl clap::ValueEnum for Shading {
+    fn value_variants<'a>() -> &'a [Self] {
+        &[Shading::Gather, Shading::Gouraud]
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()))
+    }
+}
+
 impl Shading {
     /// The flag's spelling.
     pub fn name(self) -> &'static str {
