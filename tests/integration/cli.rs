@@ -1,9 +1,8 @@
 //! The `radiosity` command as a user meets it: outputs of a solve, and every kind of bad input
 //! giving one line naming the file and the problem, exit code 2, never a panic.
 
-mod common;
 
-use common::{assert_user_error, run};
+use crate::common::{assert_user_error, run};
 use std::path::Path;
 
 fn write(dir: &Path, name: &str, text: &str) -> String {

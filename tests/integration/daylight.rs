@@ -7,8 +7,8 @@ use radiosity::scene::{Material, Scene};
 use radiosity::sky::{SkyKind, SkyLevel, SkySpec, SunLevel, EFFICACY};
 use radiosity::solve::{Solution, SolveSettings};
 
-mod common;
-use common::{closed_box, material, mesh_at, quad, solve_mesh};
+use crate::common;
+use crate::common::{closed_box, material, mesh_at, quad, solve_mesh};
 
 fn sky(kind: SkyKind, sun: Option<(f64, f64)>) -> SkySpec {
     SkySpec {

@@ -1,7 +1,7 @@
 //! Issue 15, item 1: adaptive elements (Cohen, Greenberg, Immel & Brock 1986, Sec. 3) —
 //! patches shoot, elements receive.
 
-mod common;
+use crate::common;
 
 use radiosity::elements::{self, ElementSettings, Elements};
 use radiosity::export::solution::SavedSolution;

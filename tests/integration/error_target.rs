@@ -7,7 +7,7 @@ use radiosity::mesh::Mesh;
 use radiosity::scene::Scene;
 use radiosity::solve::{self, estimate, Solution, SolveSettings, StopReason};
 
-mod common;
+use crate::common;
 
 fn load(file: &str) -> (Scene, Mesh) {
     common::project_scene(file)

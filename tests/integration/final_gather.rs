@@ -1,9 +1,8 @@
 //! The final gather (`solve::final_gather`): patches no shooting ray hit are no longer black,
 //! the gathered answer stays within its noise on scenes with a known answer, per-light channels
 //! still sum to the radiosity, and the result does not depend on the thread count.
-mod common;
 
-use common::*;
+use crate::common::*;
 use glam::{vec3, Vec3};
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::Mesh;

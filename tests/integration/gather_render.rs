@@ -1,9 +1,8 @@
 //! The final-gather renderer (`--shading gather`, `render::gather`): a furnace renders flat at
 //! its analytic radiosity, the picture is the same for a seed on any thread count, a small
 //! light's umbra is dark where the Gouraud picture blurs it, and the commands take the flags.
-mod common;
 
-use common::*;
+use crate::common::*;
 use glam::{vec3, Vec3};
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::Mesh;

@@ -11,7 +11,7 @@ use radiosity::mesh::{Mesh, MeshOptions};
 use radiosity::scene::Scene;
 use radiosity::sky::Frame;
 
-mod common;
+use crate::common;
 
 /// A quad on `pts` (in order around it), wound so it faces `normal`.
 fn quad_facing(s: &mut Scene, mut pts: [Vec3; 4], normal: Vec3) {

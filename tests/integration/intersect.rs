@@ -2,9 +2,8 @@
 //! the f64 brute-force oracle and Embree, on scenes built in code, with the edge cases of
 //! docs/design.md §4: rays along an axis, origins on a plane, shared edges and vertices, a plane of
 //! 5,000 patches, coplanar overlaps, a closed box that must not leak, skew roofs.
-mod common;
 
-use common::*;
+use crate::common::*;
 use glam::{vec3, Vec3};
 use radiosity::bench::crosscheck::{self, Class, Judge, RayGen, RaySource, TestRay};
 use radiosity::intersect::brute::BruteForce;

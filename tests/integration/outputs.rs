@@ -2,9 +2,8 @@
 //! read back with their crates' readers, and bad solution files refused with one line and exit
 //! code 2, leaving no output behind.
 
-mod common;
 
-use common::{assert_user_error, run};
+use crate::common::{assert_user_error, run};
 use radiosity::export::solution::{SavedSolution, FORMAT_VERSION};
 use radiosity::render::false_colour::{BACKGROUND, LEGEND_WIDTH};
 use std::path::{Path, PathBuf};

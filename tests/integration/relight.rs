@@ -2,9 +2,9 @@
 //! combined solution, relighting equals a fresh solve with the lights re-weighted (within the
 //! sampling error), lights group by material or by connected surface, and a solve without
 //! `--per-light` keeps no channel.
-mod common;
+use crate::common;
 
-use common::*;
+use crate::common::*;
 use glam::vec3;
 use radiosity::export::solution::{LightChannel, SavedSolution};
 use radiosity::scene::{self, LoadOptions, Scene};

@@ -2,7 +2,7 @@
 //! thread count, for every method, the default `adaptive-hybrid` included (its switch from
 //! hemi-cubes to rays is decided from counted work, not from measured times).
 
-mod common;
+use crate::common;
 
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::Mesh;

@@ -1,8 +1,7 @@
 //! Every command that solves refuses the settings `solve` refuses, with the same one-line
 //! message (issue 12): the checks live once, in the library's settings types.
-mod common;
 
-use common::*;
+use crate::common::*;
 
 /// Bad settings, each with the commands that take its flag besides `solve`.
 const BAD: &[(&[&str], &[&str])] = &[

@@ -1,8 +1,7 @@
 //! The solver on scenes with known answers: the furnace (closed box), closed-form form factors,
 //! energy balance, leaks, and thread-count independence.
-mod common;
 
-use common::*;
+use crate::common::*;
 use glam::vec3;
 use radiosity::intersect::brute::BruteForce;
 use radiosity::intersect::embree::EmbreeScene;

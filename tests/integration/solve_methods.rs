@@ -1,9 +1,8 @@
 //! Every solve method (Sec. 2 and 4, and the baselines) on scenes with known answers: the
 //! furnace, and the `blocks` scene of the paper's error analysis (Sec. 3), where all methods
 //! must agree with a high-accuracy reference within the tolerances stated per method.
-mod common;
 
-use common::*;
+use crate::common::*;
 use radiosity::mesh::Mesh;
 use radiosity::scene::{self, LoadOptions, Scene};
 use radiosity::solve::gathering::{gauss_seidel, shoot_matrix, FormFactors};

@@ -2,9 +2,8 @@
 //! near 1, where light bounces thousands of times before it is absorbed; lights a million
 //! times brighter than others; scenes from millimetres to kilometres across. Invariants
 //! everywhere: no NaN or infinity, the energy books close, no ray escapes a closed scene.
-mod common;
 
-use common::*;
+use crate::common::*;
 use glam::vec3;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, MeshOptions};

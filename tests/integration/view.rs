@@ -4,9 +4,8 @@
 //! with one line and exit code 2. Pictures are drawn `--shading gouraud`, whose pixels are exact
 //! (the gather's noise is `tests/gather_render.rs`'s business).
 
-mod common;
 
-use common::{assert_user_error, run};
+use crate::common::{assert_user_error, run};
 use radiosity::export::solution::SavedSolution;
 use std::path::{Path, PathBuf};
 
