@@ -1,73 +1,7 @@
-//! Analytic scenes built in code, shared by the integration tests.
-#![allow(dead_code)]
+//! What the integration tests share besides their scenes (`scene_builder`): running the
+//! `radiosity` binary and reading its error line, solving a mesh, and running on a thread pool.
 
-use glam::{vec3, Vec3};
-use radiosity::scene::{Material, Polygon, Scene};
-
-/// Adds a quad (counter-clockwise seen from its front).
-pub fn quad(s: &mut Scene, pts: [Vec3; 4], material: u32) {
-    let base = s.positions.len() as u32;
-    s.positions.extend_from_slice(&pts);
-    let first = s.indices.len() as u32;
-    s.indices.extend(base..base + 4);
-    s.polygons.push(Polygon {
-        first,
-        len: 4,
-        material,
-        back_material: None,
-    });
-}
-
-pub fn material(name: &str, rho: f64, ke: f64) -> Material {
-    Material {
-        name: name.into(),
-        rho: [rho; 3],
-        ke: [ke; 3],
-        ..Material::default()
-    }
-}
-
-/// A closed box [0, w]×[0, h]×[0, d] with every face pointing inwards, all of material 0.
-pub fn closed_box(w: f32, h: f32, d: f32, mat: Material) -> Scene {
-    let mut s = Scene {
-        name: "closed-box".into(),
-        materials: vec![mat],
-        ..Scene::default()
-    };
-    let p = |x: f32, y: f32, z: f32| vec3(x * w, y * h, z * d);
-    // floor (+y), ceiling (−y), walls facing in
-    quad(
-        &mut s,
-        [p(0., 0., 0.), p(0., 0., 1.), p(1., 0., 1.), p(1., 0., 0.)],
-        0,
-    );
-    quad(
-        &mut s,
-        [p(0., 1., 0.), p(1., 1., 0.), p(1., 1., 1.), p(0., 1., 1.)],
-        0,
-    );
-    quad(
-        &mut s,
-        [p(0., 0., 0.), p(1., 0., 0.), p(1., 1., 0.), p(0., 1., 0.)],
-        0,
-    );
-    quad(
-        &mut s,
-        [p(0., 0., 1.), p(0., 1., 1.), p(1., 1., 1.), p(1., 0., 1.)],
-        0,
-    );
-    quad(
-        &mut s,
-        [p(0., 0., 0.), p(0., 1., 0.), p(0., 1., 1.), p(0., 0., 1.)],
-        0,
-    );
-    quad(
-        &mut s,
-        [p(1., 0., 0.), p(1., 0., 1.), p(1., 1., 1.), p(1., 1., 0.)],
-        0,
-    );
-    s
-}
+use radiosity::scene::Scene;
 
 /// The `radiosity` binary, without RUST_BACKTRACE (so a panic shows as the one-line "panicked"
 /// the tests look for).
@@ -101,17 +35,6 @@ pub fn assert_user_error(args: &[&str], needles: &[&str]) {
     }
 }
 
-/// The scene cut into patches (its own patch size when `None`).
-pub fn mesh_at(scene: &Scene, patch_size: Option<f32>) -> radiosity::mesh::Mesh {
-    radiosity::mesh::build(
-        scene,
-        &radiosity::mesh::MeshOptions {
-            patch_size,
-            two_sided: false,
-        },
-    )
-}
-
 /// Solves by `cfg.method`, building an Embree scene only for the methods that cast rays.
 pub fn solve_mesh(
     scene: &Scene,
@@ -133,16 +56,6 @@ pub fn solve_mesh_with(
         .casts_rays()
         .then(|| radiosity::intersect::embree::EmbreeScene::build(m, |_| true).unwrap());
     radiosity::solve::run(m, &scene.materials, isect.as_ref(), cfg, hooks, |_| {}).unwrap()
-}
-
-/// A scene of the project's `scenes/` folder, meshed at its own `# radiosity: patch-size`.
-pub fn project_scene(file: &str) -> (Scene, radiosity::mesh::Mesh) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join(file);
-    let s = radiosity::scene::load_obj(&path, &radiosity::scene::LoadOptions::default()).unwrap();
-    let m = radiosity::mesh::build(&s, &radiosity::mesh::MeshOptions::default());
-    (s, m)
 }
 
 /// Runs `f` on a pool of `threads` threads, or on rayon's global pool when `None`: what the

@@ -4,6 +4,7 @@
 //! tests solve. The malformed inputs of `bad_input` are in `tests/corpus/`.
 
 mod common;
+mod scene_builder;
 
 mod bad_input;
 mod checkpoint;
