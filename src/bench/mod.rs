@@ -6,7 +6,8 @@
 //! - [`intersect`]: the jobs of `radiosity crosscheck` and `radiosity bench intersect`;
 //!   [`intersect_table`] their Markdown and CSV;
 //! - [`rays`]: raw Embree throughput against the solver's (`radiosity bench rays`);
-//! - [`sweep`]: the scene-size performance sweep over generated buildings (`radiosity sweep`).
+//! - [`sweep`]: the scene-size performance sweep over generated buildings (`radiosity sweep`);
+//! - [`timing`]: hemi-cube shots, the rasteriser and the sensor grid timed (`radiosity bench timing`).
 
 pub mod crosscheck;
 pub mod elements;
@@ -15,3 +16,4 @@ pub mod intersect_table;
 pub mod rays;
 pub mod shots;
 pub mod sweep;
+pub mod timing;
