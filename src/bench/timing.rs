@@ -83,7 +83,7 @@ pub struct GridTiming {
     pub seconds: f64,
 }
 
-/// Loads the scene and runs the three timings (the grid only when asked for).
+/// Loads the scene and runs the three timings (the grid only when asked for, and first).
 pub fn run(job: &TimingJob) -> Result<TimingReport, Error> {
     let grid = job
         .grid
@@ -95,8 +95,7 @@ pub fn run(job: &TimingJob) -> Result<TimingReport, Error> {
         })
         .transpose()?;
     let model = Model::load(&job.source, &job.load, &job.mesh)?;
-    let hemicube = hemicube_shots(&model.mesh);
-    let render = render_room();
+    // The grid first: a model it does not suit is refused before the other timings run.
     let grid = match grid {
         Some((text, spec)) => {
             let embree = EmbreeScene::build(&model.mesh, |_| true)?;
@@ -112,6 +111,8 @@ pub fn run(job: &TimingJob) -> Result<TimingReport, Error> {
         }
         None => None,
     };
+    let hemicube = hemicube_shots(&model.mesh);
+    let render = render_room();
     Ok(TimingReport {
         scene: model.scene.name.clone(),
         patches: model.mesh.patches.len(),

@@ -535,3 +535,10 @@ fn a_closed_standard_output_is_not_a_panic() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn bench_timing_refuses_a_bad_grid_before_timing() {
+    assert_user_error(&["bench", "timing", "--grid", "0.8,0"], &["--grid"]);
+    // The built-in Cornell box has no floor with a storey's clearance above it.
+    assert_user_error(&["bench", "timing", "--grid", "0.8,0.5"], &["no sensor"]);
+}
