@@ -7,7 +7,9 @@
 //!   [`intersect_table`] their Markdown and CSV;
 //! - [`rays`]: raw Embree throughput against the solver's (`radiosity bench rays`);
 //! - [`shots`]: the cost per shot and the hybrid's switch (`radiosity bench shots`);
-//! - [`sweep`]: the scene-size performance sweep over generated buildings (`radiosity sweep`).
+//! - [`sweep`]: the scene-size performance sweep over generated buildings (`radiosity sweep`);
+//! - [`timing`]: hemi-cube shots, the rasteriser and the sensor grid timed (`radiosity bench
+//!   timing`).
 //!
 //! Each command's job is a plain type here (`CrossJob`, `BenchJob`, `RaysJob`, `ShotsJob`,
 //! `ElementBenchJob`, `SweepJob`) whose `check()` refuses a bad flag before any work, with the
@@ -20,3 +22,4 @@ pub mod intersect_table;
 pub mod rays;
 pub mod shots;
 pub mod sweep;
+pub mod timing;

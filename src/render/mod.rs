@@ -676,30 +676,4 @@ mod tests {
             "a crack let the background through"
         );
     }
-
-    #[test]
-    #[ignore = "timing; run with --ignored --nocapture"]
-    fn time_100k_triangles() {
-        let (mesh, rgb) = room(91);
-        let tris = 2 * mesh.patches.len();
-        let inside = Camera::perspective(
-            Vec3::new(2.0, 3.0, 4.0),
-            Vec3::new(9.0, 7.0, 1.0),
-            Vec3::Y,
-            60.0,
-            640.0 / 480.0,
-        );
-        let outside = Camera::fit(Vec3::ZERO, Vec3::splat(10.0), 640.0 / 480.0);
-        for (name, cam) in [("inside", inside), ("fitted", outside)] {
-            let t = std::time::Instant::now();
-            let img = render_linear(&mesh, &rgb, &cam, &RenderOptions::default());
-            let dt = t.elapsed();
-            let t2 = std::time::Instant::now();
-            tone_map(&img, None);
-            println!(
-                "{tris} triangles, 640x480x9, {name}: render {dt:?}, tone map {:?}",
-                t2.elapsed()
-            );
-        }
-    }
 }

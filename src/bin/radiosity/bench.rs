@@ -115,6 +115,22 @@ pub enum BenchCommand {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Times no test asserts: a hemi-cube shot by resolution and layout (Sec. 4), the rasteriser
+    /// on 100,000 triangles and, with --grid, the sensor grid's placement.
+    Timing {
+        /// OBJ file (with its MTL beside it) to shoot hemi-cubes in and place the grid on; the
+        /// built-in Cornell box if left out.
+        scene: Option<PathBuf>,
+        #[command(flatten)]
+        scene_args: SceneArgs,
+        /// Also time the sensor grid (as `solve --grid`): e.g. 0.8,0.004 on scenes/office.obj,
+        /// about two million columns.
+        #[arg(long, value_name = "HEIGHT,SPACING|FILE")]
+        grid: Option<String>,
+        /// Also write the figures as JSON to this file.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Args)]
@@ -270,6 +286,25 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
                 reference_rays,
             };
             bench_elements(scene, scene_args, job, out)
+        }
+        BenchCommand::Timing {
+            scene,
+            scene_args,
+            grid,
+            out,
+        } => {
+            let job = radiosity::bench::timing::TimingJob {
+                source: source(scene),
+                load: scene_args.load(),
+                mesh: scene_args.mesh(),
+                grid,
+            };
+            let r = radiosity::bench::timing::run(&job)?;
+            out!("{}", r.text());
+            if let Some(path) = out {
+                write_json(&path, &r)?;
+            }
+            Ok(())
         }
     }
 }

@@ -1,9 +1,7 @@
 //! The `radiosity` command as a user meets it: outputs of a solve, and every kind of bad input
 //! giving one line naming the file and the problem, exit code 2, never a panic.
 
-mod common;
-
-use common::{assert_user_error, run};
+use crate::common::{assert_user_error, run};
 use std::path::Path;
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
@@ -28,7 +26,7 @@ fn solve_default_scene_writes_the_three_outputs() {
     assert!(stdout.contains("patches"), "{stdout}");
     let csv = std::fs::read_to_string(out.join("patches.csv")).unwrap();
     let mut lines = csv.lines();
-    // The contract's 17 columns, then issue 14's lux and daylight factor.
+    // The contract's 17 columns, then the sensor grid's lux and daylight factor.
     assert_eq!(
         lines.next().unwrap(),
         "id,cx,cy,cz,nx,ny,nz,area,rho_r,rho_g,rho_b,e_r,e_g,e_b,b_r,b_g,b_b,lux,df"
@@ -536,4 +534,11 @@ fn a_closed_standard_output_is_not_a_panic() {
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn bench_timing_refuses_a_bad_grid_before_timing() {
+    assert_user_error(&["bench", "timing", "--grid", "0.8,0"], &["--grid"]);
+    // The built-in Cornell box has no floor with a storey's clearance above it.
+    assert_user_error(&["bench", "timing", "--grid", "0.8,0.5"], &["no sensor"]);
 }

@@ -1,4 +1,4 @@
-//! Issue 13, item 1 (docs/design.md §7): sides. A doubled face (the same polygon once each way
+//! Sides (docs/design.md §7). A doubled face (the same polygon once each way
 //! round, as CAD exporters write thin surfaces) and `--two-sided` give the plain one-sided
 //! answer within its sampling noise, with the books closed; a model wound the wrong way round
 //! is never a silent black image: it warns, naming the flag that fixes it, and that flag gives
@@ -11,8 +11,8 @@ use radiosity::scene::{self, LoadOptions, Scene};
 use radiosity::solve::{self, scalar, Solution, SolveSettings};
 use std::process::Command;
 
-const OBJ: &str = include_str!("../scenes/office.obj");
-const MTL: &str = include_str!("../scenes/office.mtl");
+const OBJ: &str = include_str!("../../scenes/office.obj");
+const MTL: &str = include_str!("../../scenes/office.mtl");
 
 /// The office with every face rewritten by `f` (given the face line's vertex fields and whether
 /// the face is a light's, it returns the lines to write instead).

@@ -1,24 +1,16 @@
-//! Issue 8: stiff and extreme cases. The furnace (closed box, uniform E and ρ) at reflectances
+//! Stiff and extreme cases. The furnace (closed box, uniform E and ρ) at reflectances
 //! near 1, where light bounces thousands of times before it is absorbed; lights a million
 //! times brighter than others; scenes from millimetres to kilometres across. Invariants
 //! everywhere: no NaN or infinity, the energy books close, no ray escapes a closed scene.
-mod common;
 
-use common::*;
+use crate::scene_builder::*;
 use glam::vec3;
 use radiosity::intersect::embree::EmbreeScene;
-use radiosity::mesh::{self, MeshOptions};
 use radiosity::scene::Scene;
 use radiosity::solve::{self, scalar, MethodKind, Solution, SolveSettings, StopReason};
 
 fn solve_scene(scene: &Scene, patch_size: f32, cfg: &SolveSettings) -> Solution {
-    let m = mesh::build(
-        scene,
-        &MeshOptions {
-            patch_size: Some(patch_size),
-            two_sided: false,
-        },
-    );
+    let m = mesh_at(scene, Some(patch_size));
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     solve::solve(&m, &scene.materials, &isect, cfg, |_| {}).unwrap()
 }
@@ -215,13 +207,7 @@ fn slivers_coincident_faces_grazing_rays_and_mixed_areas() {
         let sol = solve_scene(scene, patch, &rays());
         assert_sane(&sol, name);
         assert_eq!(sol.stats.energy.escaped, [0.0; 3], "{name}: light escaped");
-        let m = mesh::build(
-            scene,
-            &MeshOptions {
-                patch_size: Some(patch),
-                two_sided: false,
-            },
-        );
+        let m = mesh_at(scene, Some(patch));
         let area: f64 = m.patches.iter().map(|p| p.area).sum();
         let mean: f64 = sol
             .b
@@ -241,11 +227,10 @@ fn slivers_coincident_faces_grazing_rays_and_mixed_areas() {
 /// books say so, and nothing else lights up.
 #[test]
 fn a_patch_that_sees_only_coplanar_neighbours() {
-    let mut s = Scene {
-        name: "floor".into(),
-        materials: vec![material("floor", 0.5, 0.0), material("lamp", 0.5, 1.0)],
-        ..Scene::default()
-    };
+    let mut s = scene(
+        "floor",
+        vec![material("floor", 0.5, 0.0), material("lamp", 0.5, 1.0)],
+    );
     for (x, m) in [(0.0, 0u32), (1.0, 1), (2.0, 0)] {
         quad(
             &mut s,
@@ -262,13 +247,7 @@ fn a_patch_that_sees_only_coplanar_neighbours() {
     assert_sane(&sol, "floor");
     let e = &sol.stats.energy;
     assert!((scalar(&e.escaped) - scalar(&e.emitted)).abs() < 1e-12 * scalar(&e.emitted));
-    let m = mesh::build(
-        &s,
-        &MeshOptions {
-            patch_size: Some(1.0),
-            two_sided: false,
-        },
-    );
+    let m = mesh_at(&s, Some(1.0));
     for (b, p) in sol.b.iter().zip(&m.patches) {
         if p.material == 0 {
             assert_eq!(scalar(b), 0.0);

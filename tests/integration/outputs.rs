@@ -1,10 +1,8 @@
-//! Issue 7's outputs as a user meets them: `solve --save` → `render` / `export`, the files
+//! The outputs as a user meets them: `solve --save` → `render` / `export`, the files
 //! read back with their crates' readers, and bad solution files refused with one line and exit
 //! code 2, leaving no output behind.
 
-mod common;
-
-use common::{assert_user_error, run};
+use crate::common::{assert_user_error, run};
 use radiosity::export::solution::{SavedSolution, FORMAT_VERSION};
 use radiosity::render::false_colour::{BACKGROUND, LEGEND_WIDTH};
 use std::path::{Path, PathBuf};
@@ -247,7 +245,7 @@ fn exports_read_back_with_vertex_counts_and_colour_ranges() {
     let dir = tempfile::tempdir().unwrap();
     let sol_path = solve_default(dir.path());
     let sol = SavedSolution::load(&sol_path).unwrap();
-    // Exports draw the elements (issue 15): the element mesh and its vertex radiosities.
+    // Exports draw the adaptive elements: the element mesh and its vertex radiosities.
     let (emesh, vertex_b) = sol.display();
     assert!(sol.elements.is_some());
     let n = emesh.vertices.len();

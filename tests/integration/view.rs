@@ -1,12 +1,10 @@
-//! Issue 15's view flags and picture units as a user meets them: `render --view FILE` (a
+//! The view flags and picture units as a user meets them: `render --view FILE` (a
 //! Radiance view file) gives the view's field and aspect, `--near` clips, and `.hdr`/`.exr`
 //! pixels are radiance B/π with the view and the unit in the header; bad view files are refused
 //! with one line and exit code 2. Pictures are drawn `--shading gouraud`, whose pixels are exact
 //! (the gather's noise is `tests/gather_render.rs`'s business).
 
-mod common;
-
-use common::{assert_user_error, run};
+use crate::common::{assert_user_error, run};
 use radiosity::export::solution::SavedSolution;
 use std::path::{Path, PathBuf};
 

@@ -1,4 +1,4 @@
-//! Issue 13, item 4: `--error E` keeps refining (independent passes, averaged) until the
+//! The error target: `--error E` keeps refining (independent passes, averaged) until the
 //! solver's own estimate is at most E; the true error falls with it; budgets stop it; the books
 //! close and the result is reproducible.
 
@@ -7,11 +7,7 @@ use radiosity::mesh::Mesh;
 use radiosity::scene::Scene;
 use radiosity::solve::{self, estimate, Solution, SolveSettings, StopReason};
 
-mod common;
-
-fn load(file: &str) -> (Scene, Mesh) {
-    common::project_scene(file)
-}
+use crate::scene_builder;
 
 fn run(s: &Scene, m: &Mesh, cfg: &SolveSettings) -> Solution {
     let isect = EmbreeScene::build(m, |_| true).unwrap();
@@ -30,7 +26,7 @@ fn estimate_of(sol: &Solution) -> f64 {
 
 #[test]
 fn the_target_is_reached_and_the_true_error_falls_with_it() {
-    let (s, m) = load("blocks.obj");
+    let (s, m) = scene_builder::project_scene("blocks.obj");
     let area: Vec<f64> = m.patches.iter().map(|p| p.area).collect();
     let reference = run(&s, &m, &SolveSettings::reference(99));
     let plain = run(&s, &m, &SolveSettings::default());
@@ -59,7 +55,7 @@ fn the_target_is_reached_and_the_true_error_falls_with_it() {
 
 #[test]
 fn a_budget_stops_the_refinement_and_says_so() {
-    let (s, m) = load("blocks.obj");
+    let (s, m) = scene_builder::project_scene("blocks.obj");
     let plain = run(&s, &m, &SolveSettings::default());
     let first = plain.stats.rays + plain.stats.hemicube_cells;
     let cfg = SolveSettings {

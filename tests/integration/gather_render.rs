@@ -1,9 +1,9 @@
 //! The final-gather renderer (`--shading gather`, `render::gather`): a furnace renders flat at
 //! its analytic radiosity, the picture is the same for a seed on any thread count, a small
 //! light's umbra is dark where the Gouraud picture blurs it, and the commands take the flags.
-mod common;
 
-use common::*;
+use crate::common::*;
+use crate::scene_builder::*;
 use glam::{vec3, Vec3};
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::light::LightAt;
@@ -211,13 +211,7 @@ fn shadow_room() -> (Scene, Mesh, Vec<[f64; 3]>) {
         2,
     );
     s.polygons.last_mut().unwrap().back_material = Some(2);
-    let m = radiosity::mesh::build(
-        &s,
-        &radiosity::mesh::MeshOptions {
-            patch_size: Some(1.0),
-            two_sided: false,
-        },
-    );
+    let m = mesh_at(&s, Some(1.0));
     let sol = solve_mesh(
         &s,
         &m,

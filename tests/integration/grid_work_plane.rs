@@ -1,4 +1,4 @@
-//! Issue 14, the sensor grid's work plane (`--grid HEIGHT,SPACING`): sensors HEIGHT above each
+//! The sensor grid's work plane (`--grid HEIGHT,SPACING`): sensors HEIGHT above each
 //! floor on a lattice offset half a spacing from the plan bounds; a floor needs 2.3 m clear above
 //! it; a sensor needs the segment up to it free. Every expected count and position below follows
 //! from that rule by hand; Embree and the brute-force oracle must agree to the bit.
@@ -11,39 +11,7 @@ use radiosity::mesh::{Mesh, MeshOptions};
 use radiosity::scene::Scene;
 use radiosity::sky::Compass;
 
-mod common;
-
-/// A quad on `pts` (in order around it), wound so it faces `normal`.
-fn quad_facing(s: &mut Scene, mut pts: [Vec3; 4], normal: Vec3) {
-    if radiosity::mesh::newell(&pts).dot(normal) < 0.0 {
-        pts.reverse();
-    }
-    common::quad(s, pts, 0);
-}
-
-/// A closed block [lo, hi], faces outwards (a desk, a beam).
-fn block(s: &mut Scene, lo: Vec3, hi: Vec3) {
-    for axis in 0..3 {
-        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-        for (side, out) in [(lo, -1.0), (hi, 1.0)] {
-            let corner = |a: f32, b: f32| {
-                let mut p = side;
-                p[u] = a;
-                p[v] = b;
-                p
-            };
-            let pts = [
-                corner(lo[u], lo[v]),
-                corner(hi[u], lo[v]),
-                corner(hi[u], hi[v]),
-                corner(lo[u], hi[v]),
-            ];
-            let mut n = Vec3::ZERO;
-            n[axis] = out;
-            quad_facing(s, pts, n);
-        }
-    }
-}
+use crate::scene_builder::*;
 
 /// A level quad over the room's whole plan [0, 4] × [0, 5] at height `y`, facing `normal`.
 fn slab(s: &mut Scene, y: f32, normal: Vec3) {
@@ -53,12 +21,12 @@ fn slab(s: &mut Scene, y: f32, normal: Vec3) {
         vec3(4.0, y, 5.0),
         vec3(0.0, y, 5.0),
     ];
-    quad_facing(s, pts, normal);
+    polygon_facing(s, &pts, normal, 0);
 }
 
 /// A room 4 m (x) × `h` (y, up) × 5 m (z), closed, faces inwards.
 fn room(h: f32) -> Scene {
-    common::closed_box(4.0, h, 5.0, common::material("white", 0.5, 0.0))
+    closed_box(4.0, h, 5.0, material("white", 0.5, 0.0))
 }
 
 fn mesh(s: &Scene, two_sided: bool) -> Mesh {
@@ -112,7 +80,7 @@ fn grid_desk_leaves_a_hole_and_no_second_plane() {
     // whether the desk top is under the sensors' height or over it.
     for (bottom, top) in [(0.72, 0.75), (0.9, 0.95)] {
         let mut s = room(3.0);
-        block(&mut s, vec3(1.0, bottom, 1.0), vec3(2.0, top, 1.6));
+        block(&mut s, vec3(1.0, bottom, 1.0), vec3(2.0, top, 1.6), 0);
         let got = plane(&mesh(&s, false), 0.8, 0.5).unwrap();
         let want: Vec<Sensor> = lattice(0.8)
             .into_iter()
@@ -135,7 +103,7 @@ fn grid_desk_is_a_floor_only_with_the_storey_clearance_above_it() {
             vec3(2.0, 0.75, 1.6),
             vec3(1.0, 0.75, 1.6),
         ];
-        quad_facing(&mut s, top, Vec3::Y);
+        polygon_facing(&mut s, &top, Vec3::Y, 0);
         let got = plane(&mesh(&s, false), 0.8, 0.5).unwrap();
         let on_desk = got
             .iter()
@@ -152,7 +120,7 @@ fn grid_sensor_needs_the_segment_up_to_it_free() {
     // the floor under it is a floor (2.4 ≥ 2.3 m clear), so a plane at 0.8 m is whole, but one
     // at 2.5 m would put those 16 sensors inside the beam.
     let mut s = room(4.0);
-    block(&mut s, vec3(0.0, 2.4, 2.0), vec3(4.0, 2.6, 3.0));
+    block(&mut s, vec3(0.0, 2.4, 2.0), vec3(4.0, 2.6, 3.0), 0);
     let m = mesh(&s, false);
     assert_eq!(plane(&m, 0.8, 0.5).unwrap(), lattice(0.8));
     let high = plane(&m, 2.5, 0.5).unwrap();
@@ -244,7 +212,7 @@ fn covers(m: &Mesh, i: usize, x: f32, z: f32) -> bool {
 
 #[test]
 fn grid_office_plane_avoids_the_furniture() {
-    let (_, m) = common::project_scene("office.obj");
+    let (_, m) = project_scene("office.obj");
     // 0.47 m puts every column at an odd multiple of 5 mm, off the office's 5 cm edges: a
     // column exactly on a block's edge meets it or not as each intersector rounds.
     let got = plane(&m, 0.8, 0.47).unwrap();
@@ -298,39 +266,21 @@ fn grid_spec_errors_name_the_flag() {
     assert!(e.to_string().starts_with("--grid expects"), "{e}");
 
     // A lone wall: nothing faces up.
-    let mut wall = Scene {
-        materials: vec![common::material("white", 0.5, 0.0)],
-        ..Scene::default()
-    };
-    quad_facing(
+    let mut wall = scene("", vec![material("white", 0.5, 0.0)]);
+    polygon_facing(
         &mut wall,
-        [
+        &[
             vec3(0.0, 0.0, 0.0),
             vec3(4.0, 0.0, 0.0),
             vec3(4.0, 3.0, 0.0),
             vec3(0.0, 3.0, 0.0),
         ],
         Vec3::Z,
+        0,
     );
     let m = mesh(&wall, false);
     let embree = EmbreeScene::build(&m, |_| true).unwrap();
     let spec: GridSpec = "0.8,0.5".parse().unwrap();
     let e = spec.sensors(&m, &embree, &frame).unwrap_err();
     assert!(matches!(e, GridError::NoFloor { .. }), "{e}");
-}
-
-/// Scale (run with `--ignored`): the office at 4 mm, 1350 × 1400 ≈ 1.9 million columns.
-#[test]
-#[ignore]
-fn grid_office_at_two_million_columns() {
-    let (_, m) = common::project_scene("office.obj");
-    let embree = EmbreeScene::build(&m, |_| true).unwrap();
-    let t = std::time::Instant::now();
-    let got = grid::work_plane(&m, &embree, &Compass::default(), 0.8, 0.004).unwrap();
-    eprintln!(
-        "{} sensors in {:.2} s",
-        got.len(),
-        t.elapsed().as_secs_f64()
-    );
-    assert!(got.len() > 1_000_000);
 }

@@ -10,10 +10,10 @@
 //!
 //! The command line is compiled here as a module (its modules name each other through
 //! `super::`), so its flags parse into the same jobs as the binary's, without running them.
-mod common;
+use crate::common;
 
 #[allow(dead_code, unused_imports)]
-#[path = "../src/bin/radiosity/main.rs"]
+#[path = "../../src/bin/radiosity/main.rs"]
 mod cli;
 
 use clap::{CommandFactory, Parser};

@@ -1,28 +1,24 @@
-//! Per-light channels and relighting (issue 7; the paper's Images 1a/1b): channels sum to the
+//! Per-light channels and relighting (the paper's Images 1a/1b): channels sum to the
 //! combined solution, relighting equals a fresh solve with the lights re-weighted (within the
 //! sampling error), lights group by material or by connected surface, and a solve without
 //! `--per-light` keeps no channel.
-mod common;
+use crate::common;
 
-use common::*;
+use crate::common::*;
+use crate::scene_builder::*;
 use glam::vec3;
 use radiosity::export::solution::{LightChannel, SavedSolution};
-use radiosity::scene::{self, LoadOptions, Scene};
+use radiosity::scene::Scene;
 use radiosity::solve::estimate::against;
 use radiosity::solve::lights::{groups, GroupBy};
 use radiosity::solve::{scalar, MethodKind, RunHooks, SolveSettings};
 use std::path::Path;
 use std::sync::Arc;
 
-fn office() -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/office.obj");
-    scene::load_obj(&path, &LoadOptions::default()).unwrap()
-}
-
 /// Channels sum to the combined solution, for shooting by rays, by hemi-cube and gathering.
 #[test]
 fn channels_sum_to_the_combined_solution() {
-    let scene = office();
+    let scene = load_project_scene("office.obj");
     let m = mesh_at(&scene, Some(0.6));
     let g = groups(&scene, &m, GroupBy::Material);
     assert_eq!(g.names, ["light_front", "light_rear"]);
@@ -70,7 +66,7 @@ fn channels_sum_to_the_combined_solution() {
 /// 2× the combined estimate).
 #[test]
 fn relighting_equals_a_fresh_solve_with_the_weights() {
-    let scene = office();
+    let scene = load_project_scene("office.obj");
     let m = mesh_at(&scene, Some(0.6));
     let g = groups(&scene, &m, GroupBy::Material);
     let cfg = SolveSettings {

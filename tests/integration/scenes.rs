@@ -2,6 +2,7 @@
 //! patch count and axis-aligned share that `scenes/README.md` documents, and is closed — no
 //! ray cast from inside escapes or meets a back face.
 
+use crate::scene_builder::mesh_at;
 use glam::Vec3;
 use radiosity::generate::{self, BuildingOptions, BUILDING_PATCH_SIZE};
 use radiosity::intersect::embree::{set_flush_denormals, EmbreeScene};
@@ -55,16 +56,6 @@ fn documented(file: &str) -> Documented {
         axial: number(4) / 100.0,
         lights: number(5) as usize,
     }
-}
-
-fn mesh_at(scene: &Scene, patch_size: f32) -> Mesh {
-    mesh::build(
-        scene,
-        &MeshOptions {
-            patch_size: Some(patch_size),
-            two_sided: false,
-        },
-    )
 }
 
 /// A uniform random point of patch `i` (a convex polygon, fanned from its first vertex).
@@ -256,7 +247,7 @@ fn generated_buildings_are_closed_and_sized_as_asked() {
         assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
         assert!(scene.has_emitter());
         assert_eq!(scene.polygons.len() as u64, stats.polygons);
-        let m = mesh_at(&scene, BUILDING_PATCH_SIZE);
+        let m = mesh_at(&scene, Some(BUILDING_PATCH_SIZE));
         let n = m.patches.len();
         // ±20 %: the issue's promise for `--patches N`.
         assert!(
@@ -319,7 +310,7 @@ fn same_seed_same_bytes_other_seed_other_bytes() {
     assert_ne!(a_obj, c_obj, "different seeds, same output");
 }
 
-/// Issue 3: `--patches N` lands within ±20 % of N at the default patch size, counted by the
+/// `--patches N` lands within ±20 % of N at the default patch size, counted by the
 /// real mesher, including the small sizes where a building grows by whole rooms of ~1,000
 /// patches (1,200–1,900 used to miss).
 #[test]
@@ -330,7 +321,7 @@ fn patch_targets_land_within_twenty_per_cent_by_the_mesher() {
         for seed in [1, 2] {
             let opts = BuildingOptions::for_patches(target, seed);
             let (obj, mtl, stats) = building(&opts);
-            let n = mesh_at(&load_building(&obj, &mtl), BUILDING_PATCH_SIZE)
+            let n = mesh_at(&load_building(&obj, &mtl), Some(BUILDING_PATCH_SIZE))
                 .patches
                 .len();
             assert!(

@@ -1,4 +1,4 @@
-//! Issue 14, daylight: the sky, ground glow and sun as distant emitters that shoot first, and
+//! Daylight: the sky, ground glow and sun as distant emitters that shoot first, and
 //! glazing. Furnaces: an unobstructed horizontal plane under a sky receives exactly the sky's
 //! horizontal illuminance; a closed box receives nothing; a pane of transmittance T passes T.
 
@@ -7,8 +7,9 @@ use radiosity::scene::{Material, Scene};
 use radiosity::sky::{SkyKind, SkyLevel, SkySpec, SunLevel, EFFICACY};
 use radiosity::solve::{Solution, SolveSettings};
 
-mod common;
-use common::{closed_box, material, mesh_at, quad, solve_mesh};
+use crate::common;
+use crate::common::solve_mesh;
+use crate::scene_builder::{closed_box, material, mesh_at, quad, scene};
 
 fn sky(kind: SkyKind, sun: Option<(f64, f64)>) -> SkySpec {
     SkySpec {
@@ -52,10 +53,7 @@ fn lux(
 
 /// A 10 m × 10 m horizontal plane facing up (Y), ρ = 0.5.
 fn plane() -> Scene {
-    let mut s = Scene {
-        materials: vec![material("grey", 0.5, 0.0)],
-        ..Scene::default()
-    };
+    let mut s = scene("", vec![material("grey", 0.5, 0.0)]);
     let p = |x, z| vec3(x, 0.0, z);
     quad(&mut s, [p(-5., 5.), p(5., 5.), p(5., -5.), p(-5., -5.)], 0);
     s

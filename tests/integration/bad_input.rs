@@ -1,4 +1,4 @@
-//! Issue 8, "Bad input": every malformed file in `tests/corpus/` and every bad flag value or
+//! Bad input: every malformed file in `tests/corpus/` and every bad flag value or
 //! combination gives exactly one error line naming the problem, exit code 2, no panic, and
 //! leaves no output behind (no file, no temporary file, no new folder); the odd but valid
 //! files (`odd-*`: comments after the data, continued lines, Kd of 1 or more, textures) load

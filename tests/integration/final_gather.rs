@@ -1,9 +1,8 @@
 //! The final gather (`solve::final_gather`): patches no shooting ray hit are no longer black,
 //! the gathered answer stays within its noise on scenes with a known answer, per-light channels
 //! still sum to the radiosity, and the result does not depend on the thread count.
-mod common;
 
-use common::*;
+use crate::scene_builder::*;
 use glam::{vec3, Vec3};
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::Mesh;
@@ -11,22 +10,6 @@ use radiosity::scene::Scene;
 use radiosity::solve::lights::{self, GroupBy};
 use radiosity::solve::{self, scalar, MethodKind, RunHooks, Solution, SolveSettings};
 use std::sync::Arc;
-
-/// Adds an axis-aligned box [lo, hi] with outward faces, without its bottom (it stands on
-/// something).
-fn open_box(s: &mut Scene, lo: Vec3, hi: Vec3, material: u32) {
-    let (x0, y0, z0, x1, y1, z1) = (lo.x, lo.y, lo.z, hi.x, hi.y, hi.z);
-    let faces = [
-        [(x0, y1, z0), (x0, y1, z1), (x1, y1, z1), (x1, y1, z0)], // top, +y
-        [(x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)], // +z
-        [(x1, y0, z0), (x0, y0, z0), (x0, y1, z0), (x1, y1, z0)], // −z
-        [(x1, y0, z1), (x1, y0, z0), (x1, y1, z0), (x1, y1, z1)], // +x
-        [(x0, y0, z0), (x0, y0, z1), (x0, y1, z1), (x0, y1, z0)], // −x
-    ];
-    for f in faces {
-        quad(s, f.map(|(x, y, z)| vec3(x, y, z)), material);
-    }
-}
 
 /// A closed 1 m room (ρ 0.5) lit by a 0.4 m lamp just under the ceiling, facing down, with a
 /// 5 mm cube on the middle of the floor: its faces are 1/2,500 of a typical patch's area, so

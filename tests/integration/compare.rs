@@ -1,10 +1,8 @@
-//! Issue 6: `radiosity reference` states an error bound that holds, and `radiosity compare`
+//! `radiosity reference` states an error bound that holds, and `radiosity compare`
 //! writes its CSV, plots and Markdown. Nothing here is timed: the speedups are measured by the
 //! reproduction (README), not asserted.
 
-mod common;
-
-use common::radiosity;
+use crate::common::radiosity;
 use radiosity::compare::reference;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, MeshOptions};

@@ -2,7 +2,7 @@
 //! uninterrupted one does, for the same seed; Ctrl-C (the interrupt flag) stops at a safe
 //! point with a checkpoint; corrupt, truncated or foreign checkpoints are refused.
 
-mod common;
+use crate::common;
 
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::mesh::{self, Mesh, MeshOptions};

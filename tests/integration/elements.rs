@@ -1,7 +1,8 @@
-//! Issue 15, item 1: adaptive elements (Cohen, Greenberg, Immel & Brock 1986, Sec. 3) —
+//! Adaptive elements (Cohen, Greenberg, Immel & Brock 1986, Sec. 3) —
 //! patches shoot, elements receive.
 
-mod common;
+use crate::common;
+use crate::scene_builder;
 
 use radiosity::elements::{self, ElementSettings, Elements};
 use radiosity::export::solution::SavedSolution;
@@ -31,7 +32,7 @@ fn refined(
 
 #[test]
 fn elements_tile_each_patch_exactly() {
-    let (s, m) = common::project_scene("spot.obj");
+    let (s, m) = scene_builder::project_scene("spot.obj");
     let (_, el, st) = refined(&s, &m, &ElementSettings::default(), None);
     assert!(st.count as usize > m.patches.len(), "{st:?}");
     let mut area = vec![0.0f64; m.patches.len()];
@@ -62,8 +63,8 @@ fn elements_tile_each_patch_exactly() {
 #[test]
 fn a_uniformly_lit_furnace_is_not_subdivided() {
     let (rho, ke) = (0.5, 1.0);
-    let s = common::closed_box(2.0, 2.0, 2.0, common::material("m", rho, ke));
-    let m = common::mesh_at(&s, Some(0.5));
+    let s = scene_builder::closed_box(2.0, 2.0, 2.0, scene_builder::material("m", rho, ke));
+    let m = scene_builder::mesh_at(&s, Some(0.5));
     let (_, el, st) = refined(&s, &m, &ElementSettings::default(), None);
     assert_eq!(st.count as usize, m.patches.len(), "{st:?}");
     let exact = std::f64::consts::PI * ke / (1.0 - rho);
@@ -81,7 +82,7 @@ fn a_uniformly_lit_furnace_is_not_subdivided() {
 /// is not (at a threshold of 0.01, as `radiosity bench elements` measures it).
 #[test]
 fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
-    let (s, m) = common::project_scene("spot.obj");
+    let (s, m) = scene_builder::project_scene("spot.obj");
     let settings = ElementSettings {
         threshold: 0.01,
         ..Default::default()
@@ -132,7 +133,7 @@ fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
 /// with its corners gathered, and the stats say so.
 #[test]
 fn ctrl_c_keeps_what_is_refined() {
-    let (s, m) = common::project_scene("spot.obj");
+    let (s, m) = scene_builder::project_scene("spot.obj");
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let sol = solve::solve(&m, &s.materials, &isect, &SolveSettings::default(), |_| {}).unwrap();
     let gather = LightAt::new(&m, &s.materials, &isect, &sol.b, None, None);
@@ -160,7 +161,7 @@ fn ctrl_c_keeps_what_is_refined() {
 
 #[test]
 fn elements_do_not_depend_on_the_thread_count() {
-    let (s, m) = common::project_scene("spot.obj");
+    let (s, m) = scene_builder::project_scene("spot.obj");
     let settings = ElementSettings::default();
     let (_, one, _) = refined(&s, &m, &settings, Some(1));
     let (_, two, _) = refined(&s, &m, &settings, Some(2));

@@ -1,25 +1,14 @@
 //! The solver on scenes with known answers: the furnace (closed box), closed-form form factors,
 //! energy balance, leaks, and thread-count independence.
-mod common;
 
-use common::*;
+use crate::scene_builder::*;
 use glam::vec3;
 use radiosity::intersect::brute::BruteForce;
 use radiosity::intersect::embree::EmbreeScene;
 use radiosity::intersect::Intersector;
-use radiosity::mesh::{self, Mesh, MeshOptions};
+use radiosity::mesh::Mesh;
 use radiosity::scene::Scene;
 use radiosity::solve::{self, scalar, MethodKind, Solution, SolveSettings, StopReason};
-
-fn mesh_of(scene: &Scene, patch_size: f32) -> Mesh {
-    mesh::build(
-        scene,
-        &MeshOptions {
-            patch_size: Some(patch_size),
-            two_sided: false,
-        },
-    )
-}
 
 fn run<I: Intersector>(scene: &Scene, m: &Mesh, isect: &I, cfg: &SolveSettings) -> Solution {
     solve::solve(m, &scene.materials, isect, cfg, |_| {}).unwrap()
@@ -30,7 +19,7 @@ fn run<I: Intersector>(scene: &Scene, m: &Mesh, isect: &I, cfg: &SolveSettings) 
 fn closed_box_reaches_e_over_one_minus_rho() {
     let (rho, ke) = (0.5, 1.0 / std::f64::consts::PI); // E = 1 W/m²
     let scene = closed_box(1.0, 1.0, 1.0, material("wall", rho, ke));
-    let m = mesh_of(&scene, 0.25);
+    let m = mesh_at(&scene, Some(0.25));
     assert_eq!(m.patches.len(), 96);
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let sol = run(&scene, &m, &isect, &ray_config());
@@ -52,11 +41,10 @@ fn closed_box_reaches_e_over_one_minus_rho() {
 /// Two unit squares facing each other at distance 1 (parallel) or sharing an edge at right
 /// angles (perpendicular): `a` (patch 0) emits with ρ = 0, `b` is black.
 fn two_squares(parallel: bool) -> Scene {
-    let mut s = Scene {
-        name: "two-squares".into(),
-        materials: vec![material("emitter", 0.0, 1.0), material("black", 0.0, 0.0)],
-        ..Scene::default()
-    };
+    let mut s = scene(
+        "two-squares",
+        vec![material("emitter", 0.0, 1.0), material("black", 0.0, 0.0)],
+    );
     // a: the unit square in z = 0, facing +z.
     quad(
         &mut s,
@@ -115,7 +103,7 @@ fn form_factor<I: Intersector>(scene: &Scene, m: &Mesh, isect: &I, rays: f64) ->
 fn form_factors_match_closed_forms() {
     for (parallel, exact) in [(true, 0.199_825), (false, 0.200_044)] {
         let scene = two_squares(parallel);
-        let m = mesh_of(&scene, 2.0);
+        let m = mesh_at(&scene, Some(2.0));
         assert_eq!(m.patches.len(), 2);
         let embree = EmbreeScene::build(&m, |_| true).unwrap();
         // One shot of 2·700² ≈ 10⁶ rays: the binomial standard error sqrt(F(1−F)/N) is 4e-4
@@ -140,7 +128,7 @@ fn form_factors_match_closed_forms() {
 #[test]
 fn no_ray_escapes_a_closed_box() {
     let scene = closed_box(1.0, 0.7, 1.3, material("wall", 0.6, 1.0));
-    let m = mesh_of(&scene, 0.09);
+    let m = mesh_at(&scene, Some(0.09));
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let emitted: f64 = m.patches.iter().map(|p| p.area).sum::<f64>() * std::f64::consts::PI;
     let cfg = SolveSettings {
@@ -164,7 +152,7 @@ fn no_ray_escapes_a_closed_box() {
 #[test]
 fn result_does_not_depend_on_thread_count() {
     let scene = closed_box(1.0, 0.8, 1.2, material("wall", 0.7, 0.3));
-    let m = mesh_of(&scene, 0.1);
+    let m = mesh_at(&scene, Some(0.1));
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let cfg = SolveSettings {
         seed: 42,
