@@ -273,6 +273,22 @@ pub fn run(
             seconds: st.seconds,
         });
     }
+    let comparisons = compare_rows(&rows);
+    Ok(ElementBenchReport {
+        scene: model.scene.name.clone(),
+        patches: m.patches.len(),
+        min_size,
+        rays: job.rays,
+        reference_rays: job.reference_rays,
+        reference_elements: rs.count,
+        rows,
+        comparisons,
+    })
+}
+
+/// Each adaptive row against the uniform meshes: uniform meshing's error at the row's element
+/// count, and its count at the row's error, interpolated on the uniform rows' curve.
+fn compare_rows(rows: &[ElementBenchRow]) -> Vec<Comparison> {
     let uniform: Vec<(f64, f64)> = rows
         .iter()
         .filter(|r| r.kind == "uniform" && r.error > 0.0)
@@ -281,8 +297,7 @@ pub fn run(
     // Error falls with the count: for the count at an error, interpolate the reversed curve.
     let mut by_error: Vec<(f64, f64)> = uniform.iter().map(|&(n, e)| (e, n)).collect();
     by_error.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let comparisons = rows
-        .iter()
+    rows.iter()
         .filter(|r| r.kind == "adaptive")
         .map(|r| {
             let n = r.elements as f64;
@@ -299,17 +314,7 @@ pub fn run(
                 count_ratio: un.map(|u| n / u),
             }
         })
-        .collect();
-    Ok(ElementBenchReport {
-        scene: model.scene.name.clone(),
-        patches: m.patches.len(),
-        min_size,
-        rays: job.rays,
-        reference_rays: job.reference_rays,
-        reference_elements: rs.count,
-        rows,
-        comparisons,
-    })
+        .collect()
 }
 
 impl ElementBenchReport {

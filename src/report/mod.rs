@@ -356,7 +356,7 @@ pub struct Summary {
     pub settings: serde_json::Value,
     /// The max-unshot trace, against time and shots.
     pub trace: Vec<TracePoint>,
-    /// The sky (issue 14), when the solve had one.
+    /// The sky (docs/design.md §9), when the solve had one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sky: Option<sky::SkyReport>,
     /// The sensor grid's statistics (`--grid`).

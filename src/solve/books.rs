@@ -569,6 +569,8 @@ impl State {
     /// Adds a trace point (and tells the caller): the solver's own error estimate always, the
     /// error against `reference` when there is one. The heap knows the max only above the stop
     /// threshold; a trace point is rare enough to scan for the exact value.
+    // Eight: the books, and the driver's running figures (stats, time, the stop's max, the
+    // estimator, the reference, what is in flight), each owned by a different part of it.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,

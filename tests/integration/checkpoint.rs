@@ -1,4 +1,4 @@
-//! Checkpoints (issue 8): a solve resumed from a checkpoint ends exactly where the
+//! Checkpoints (docs/design.md §6): a solve resumed from a checkpoint ends exactly where the
 //! uninterrupted one does, for the same seed; Ctrl-C (the interrupt flag) stops at a safe
 //! point with a checkpoint; corrupt, truncated or foreign checkpoints are refused.
 
@@ -265,8 +265,8 @@ fn command_line_checkpoints_and_refusals() {
     );
 }
 
-/// The checkpoint key is derived from every setting that shapes the result (issue 12): a
-/// setting added to the settings types reaches it without being listed. `--switch-by` (added
+/// The checkpoint key is derived from every setting that shapes the result (docs/design.md
+/// §6): a setting added to the settings types reaches it without being listed. `--switch-by` (added
 /// after the key stopped being written by hand) is in it; the budgets are not, so a run may be
 /// resumed with more time.
 #[test]
