@@ -210,8 +210,8 @@ pub fn render_room() -> Vec<RenderTiming> {
 }
 
 /// A closed box room 10 m wide of `n`×`n` quads per wall (2·6·n² triangles), normals inward,
-/// with a colour per vertex.
-fn room(n: usize) -> (Mesh, Vec<[f32; 3]>) {
+/// with a colour per vertex (also the renderer's tests' room).
+pub(crate) fn room(n: usize) -> (Mesh, Vec<[f32; 3]>) {
     let size = 10.0;
     let mut mesh = Mesh::default();
     let mut rgb = Vec::new();

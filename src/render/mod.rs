@@ -434,36 +434,6 @@ mod tests {
         let _ = Camera::fit(Vec3::INFINITY, Vec3::NEG_INFINITY, f32::NAN);
     }
 
-    /// A closed box room of `n`×`n` quads per wall (2·6·n² triangles), normals inward.
-    fn room(n: usize) -> (Mesh, Vec<[f32; 3]>) {
-        let mut qs = Vec::new();
-        let size = 10.0;
-        for axis in 0..3 {
-            for side in [0.0f32, 1.0] {
-                for i in 0..n {
-                    for j in 0..n {
-                        let at = |u: usize, v: usize| {
-                            let (u, v) = (u as f32 / n as f32 * size, v as f32 / n as f32 * size);
-                            let mut p = [0.0; 3];
-                            p[axis] = side * size;
-                            p[(axis + 1) % 3] = u;
-                            p[(axis + 2) % 3] = v;
-                            Vec3::from_array(p)
-                        };
-                        let mut c = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
-                        // Counter-clockwise seen from inside the room.
-                        if side > 0.5 {
-                            c.reverse();
-                        }
-                        let col = [(i * j % 7) as f32 / 7.0, 0.5, side];
-                        qs.push((c, [col; 4]));
-                    }
-                }
-            }
-        }
-        quads(&qs)
-    }
-
     /// Cameras of every kind: perspective and parallel, shifted and lifted, clipped, aimed
     /// off the axes.
     fn cameras() -> Vec<Camera> {
@@ -661,7 +631,7 @@ mod tests {
 
     #[test]
     fn room_is_closed_seen_from_inside() {
-        let (mesh, rgb) = room(8);
+        let (mesh, rgb) = crate::bench::timing::room(8);
         let cam = Camera::perspective(
             Vec3::new(2.0, 3.0, 4.0),
             Vec3::new(9.0, 7.0, 1.0),

@@ -112,6 +112,7 @@ const BAD: &[(&[&str], &[&str])] = &[
             "bench-rays",
             "bench-elements",
             "bench-intersect",
+            "bench-timing",
             "compare",
             "reference",
             "info",
@@ -125,6 +126,7 @@ const BAD: &[(&[&str], &[&str])] = &[
             "bench-rays",
             "bench-elements",
             "bench-intersect",
+            "bench-timing",
             "compare",
             "reference",
             "info",
@@ -151,6 +153,7 @@ fn line(cmd: &str, extra: &[&str], dir: &str) -> Vec<String> {
         ],
         "bench-shots" => vec!["bench".into(), "shots".into()],
         "bench-elements" => vec!["bench".into(), "elements".into()],
+        "bench-timing" => vec!["bench".into(), "timing".into()],
         "bench-intersect" => vec![
             "bench".into(),
             "intersect".into(),

@@ -292,21 +292,29 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
             scene_args,
             grid,
             out,
-        } => {
-            let job = radiosity::bench::timing::TimingJob {
-                source: source(scene),
-                load: scene_args.load(),
-                mesh: scene_args.mesh(),
-                grid,
-            };
-            let r = radiosity::bench::timing::run(&job)?;
-            out!("{}", r.text());
-            if let Some(path) = out {
-                write_json(&path, &r)?;
-            }
-            Ok(())
-        }
+        } => bench_timing(scene, scene_args, grid, out),
     }
+}
+
+/// `bench timing`: hemi-cube shots, the rasteriser and the sensor grid timed.
+fn bench_timing(
+    scene: Option<PathBuf>,
+    scene_args: SceneArgs,
+    grid: Option<String>,
+    out: Option<PathBuf>,
+) -> Result<(), radiosity::Error> {
+    let job = radiosity::bench::timing::TimingJob {
+        source: source(scene),
+        load: scene_args.load(),
+        mesh: scene_args.mesh(),
+        grid,
+    };
+    let r = radiosity::bench::timing::run(&job)?;
+    out!("{}", r.text());
+    if let Some(path) = out {
+        write_json(&path, &r)?;
+    }
+    Ok(())
 }
 
 fn bench_elements(
