@@ -58,7 +58,7 @@ impl Stream {
 /// The random numbers of one stream's chunk of samples (a shot's chunk, a gathered patch, a
 /// pixel): a function of (seed, stream, chunk) only, so results do not depend on which thread
 /// draws them.
-pub(crate) fn rng_for(seed: u64, stream: Stream, chunk: u64) -> rand_pcg::Pcg64Mcg {
+pub fn rng_for(seed: u64, stream: Stream, chunk: u64) -> rand_pcg::Pcg64Mcg {
     use rand::SeedableRng;
     rand_pcg::Pcg64Mcg::seed_from_u64(mix(mix(mix(seed) ^ stream.id()) ^ chunk))
 }
