@@ -123,7 +123,7 @@ pub(super) struct State {
     pub channels: Option<Channels>,
 }
 
-/// What a checkpoint keeps of the books ([`State::save`], [`State::restore`]): every
+/// What a checkpoint keeps of the books (`State::save`, `State::restore`): every
 /// patch's unshot and kept flux, the hemi-cube share of the kept flux and its variance, the
 /// per-light channels, and the energy accounts and counters. [`super::checkpoint`] lays it out
 /// in the file.

@@ -14,7 +14,7 @@
 //!
 //! The file: the [`crate::container`] without reserved words — an 8-byte magic, a format
 //! version (u32), the payload's length (u64) and its CRC-32 (u32) — then the payload: a JSON
-//! header ([`Header`]: settings key, counters, trace) behind its length (u64), then the
+//! header (`Header`: settings key, counters, trace) behind its length (u64), then the
 //! per-patch arrays as little-endian f64: unshot and kept flux (× 3 per patch), the hemi-cube
 //! share of the kept flux and its variance (`cube_len` each), the light channels' unshot and
 //! kept flux (× 3, `channels` per patch). A file from another scene or other settings (the key

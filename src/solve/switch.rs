@@ -389,7 +389,7 @@ pub(super) fn probe<I: Intersector>(caster: &RayCaster<I>, patch: usize) -> f64 
     per_ray
 }
 
-/// What a checkpoint keeps of the switch policy ([`SwitchPolicy::save`]): what it has learnt
+/// What a checkpoint keeps of the switch policy (`SwitchPolicy::save`): what it has learnt
 /// so far, so a resumed run decides as the uninterrupted one. [`super::checkpoint`] lays it
 /// out in the file.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
