@@ -181,7 +181,7 @@ impl Camera {
     /// from. A degenerate camera (eye == target, up parallel to the view direction, non-finite
     /// values) falls back to looking along -z and to another up vector (y, z or x), so every
     /// camera can draw.
-    pub fn frame(&self) -> Frame {
+    pub fn frame(&self) -> CameraFrame {
         let mut fwd = (self.target - self.eye).normalize_or_zero();
         if !fwd.is_finite() || fwd == Vec3::ZERO {
             fwd = Vec3::NEG_Z;
@@ -192,7 +192,7 @@ impl Camera {
             // sin of the angle between fwd and up above 1e-3: the frame is well conditioned.
             if r.is_finite() && r.length_squared() > 1e-6 {
                 let right = r.normalize();
-                return Frame {
+                return CameraFrame {
                     right,
                     up: right.cross(fwd),
                     fwd,
@@ -201,7 +201,7 @@ impl Camera {
             }
         }
         // Not reached (one of y, z, x is at least 54° from any unit vector), but never panic.
-        Frame {
+        CameraFrame {
             right: Vec3::X,
             up: Vec3::Y,
             fwd: Vec3::NEG_Z,
@@ -305,7 +305,7 @@ impl Camera {
 
 /// A camera's orthonormal frame ([`Camera::frame`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Frame {
+pub struct CameraFrame {
     pub right: Vec3,
     pub up: Vec3,
     pub fwd: Vec3,

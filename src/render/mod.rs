@@ -31,7 +31,7 @@ mod tone;
 pub mod view;
 pub mod view_file;
 
-pub use camera::{Camera, Frame, Projection};
+pub use camera::{Camera, CameraFrame, Projection};
 pub use gather::{render_gather, Shading, ShadingSettings};
 pub use tone::{auto_exposure, srgb_encode, tone_map};
 pub use view::{CameraSpec, ViewSettings};
