@@ -92,6 +92,16 @@ impl Model {
         })
     }
 
+    /// Finds the sides of the mesh's surfaces that no light can reach ([`crate::mesh::Hidden`],
+    /// `intersect::hidden`), with `isect` built over this mesh.
+    pub fn find_hidden<I: Intersector>(&mut self, isect: &I, seed: u64) {
+        let materials = &self.scene.materials;
+        let open: Vec<bool> = (self.mesh.patches.iter())
+            .map(|p| materials[p.material as usize].transmittance > 0.0)
+            .collect();
+        self.mesh.hidden = crate::intersect::hidden::find(&self.mesh, isect, &open, seed);
+    }
+
     /// Scalar flux the lights emit (W): what a solve's progress is measured against.
     pub fn emitted_flux(&self) -> f64 {
         let materials = &self.scene.materials;

@@ -34,6 +34,9 @@ pub enum Stream {
     Picture,
     /// The adaptive elements' corner gathers (`u64::MAX − 5`).
     Elements,
+    /// The probes that find the hidden sides of surfaces (`u64::MAX − 6`,
+    /// `intersect::hidden`).
+    Hidden,
 }
 
 /// Regather round k draws under `Stream::Gather`'s number less k times this.
@@ -51,6 +54,7 @@ impl Stream {
             Stream::Sensors => u64::MAX - 3,
             Stream::Picture => u64::MAX - 4,
             Stream::Elements => u64::MAX - 5,
+            Stream::Hidden => u64::MAX - 6,
         }
     }
 }
@@ -80,5 +84,6 @@ mod tests {
         assert_eq!(Stream::Sensors.id(), u64::MAX - 3);
         assert_eq!(Stream::Picture.id(), u64::MAX - 4);
         assert_eq!(Stream::Elements.id(), u64::MAX - 5);
+        assert_eq!(Stream::Hidden.id(), u64::MAX - 6);
     }
 }

@@ -23,6 +23,26 @@ Variants, all from the same geometry (``--variant``):
 * ``doubled``: every face written twice, once each way round (as SketchUp and CAD exporters do);
 * ``inside-out``: room B's shell (floor, walls, ceiling) wound the wrong way round.
 
+Style (``--style``): ``clean`` is the above; ``converted`` is the same rooms and furniture written
+the way exported models come (CAD, IFC and glTF exports converted to OBJ), as ``converted-*.obj``:
+
+* nothing is cut where it touches: furniture stands on the whole floor with its bottom faces
+  kept (coincident with the floor, facing it), books lie on whole boards, shelves' backs lie on
+  the wall;
+* legs, plinths and cabinets are sunk 1 cm into the floor (faces that interpenetrate);
+* the lights are luminaire objects, not flush panels: two closed boxes (an emitting bottom face,
+  metal sides, the top face lying on the ceiling), two thin panels hung 0.3 m down with every
+  face emitting (one material for the whole object, as exporters do), one single downward face
+  2 cm below the ceiling;
+* a partition wall in the office built as two overlapping boxes and a column through the floor
+  and the ceiling (buried faces, faces inside other solids);
+* every polygon written as fan triangles (exporters triangulate); the doubled copy of a face is
+  triangulated along the other diagonal, so its triangles are not the first copy's.
+
+Variants of the converted style: ``plain`` (consistently wound), ``doubled``, ``inside-out``, and
+``mixed``: 30 % of the faces (seeded) wound the wrong way round, as in models stitched together
+from several sources.
+
 Materials: plain ``Kd`` colours, and textured ones (``Kd 1 1 1`` + ``map_Kd``: the PNG textures
 are written by this script); lights are ``Ke`` (emitted radiance, W/sr/m^2) with ``Kd 0 0 0``.
 
@@ -47,6 +67,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import r6  # noqa: E402
 
 VARIANTS = ("plain", "doubled", "inside-out")
+CONVERTED_VARIANTS = ("plain", "doubled", "inside-out", "mixed")
+SINK = 0.01  # how far the converted style sinks furniture into the floor (m)
 
 # Room geometry (metres).
 HEIGHT = 2.8
@@ -224,13 +246,19 @@ class Assembly:
     rects: list
     angle: float
     pivot: tuple
+    converted: bool = False
 
     def finish(self):
-        """(polygons, footprints): footprints are the turned rectangles (4 corners x, z)."""
-        cut_contacts(self.rects)
+        """(polygons, footprints): footprints are the turned rectangles (4 corners x, z).
+        Converted: nothing cut, bottoms kept and sunk, no footprints."""
+        if self.converted:
+            for r in self.rects:
+                sink(r)
+        else:
+            cut_contacts(self.rects)
         polys, feet = [], []
         for r in self.rects:
-            if r.axis == 1 and r.sign < 0 and r.coord == 0.0:
+            if not self.converted and r.axis == 1 and r.sign < 0 and r.coord == 0.0:
                 corners = [(r.v0, r.u0), (r.v1, r.u0), (r.v1, r.u1), (r.v0, r.u1)]  # (x, z)
                 feet.append([rotate_y((x, 0.0, z), self.angle, self.pivot) for x, z in corners])
                 continue
@@ -238,6 +266,18 @@ class Assembly:
                 polys.append(Poly([rotate_y(q, self.angle, self.pivot) for q in p.verts],
                                   p.material, p.tag))
         return polys, feet
+
+
+def sink(r: Rect):
+    """A furniture face at or from the floor (y = 0) moved or stretched SINK into it."""
+    if r.axis == 1:
+        if r.coord == 0.0:
+            r.coord = -SINK
+    elif r.axis == 0:  # u = y
+        if r.u0 == 0.0:
+            r.u0 = -SINK
+    elif r.v0 == 0.0:  # axis 2: v = y
+        r.v0 = -SINK
 
 
 def footprint_fill(foot, material, tag):
@@ -421,8 +461,9 @@ def laptop_polys(x0, y0, z0, angle_deg=105.0):
 # The two rooms.
 
 
-def build(seed=1):
-    """All polygons of the scene, each tagged with the room shell or object it belongs to."""
+def build(seed=1, converted=False):
+    """All polygons of the scene, each tagged with the room shell or object it belongs to
+    (``converted``: the converted style of the module's docstring)."""
     rng = random.Random(seed)
     rects, polys, feet = [], [], []
     z0, z1 = Z_RANGE
@@ -457,7 +498,18 @@ def build(seed=1):
     lights = [("lamp_a1", (1.2, 2.4), (-1.8, -1.5)), ("lamp_a1", (3.6, 4.8), (-1.8, -1.5)),
               ("lamp_a2", (1.2, 2.4), (-3.8, -3.5)), ("lamp_a2", (3.6, 4.8), (-3.8, -3.5)),
               ("lamp_b", (7.6, 8.8), (-2.7, -2.3))]
-    for name, (lx0, lx1), (lz0, lz1) in lights:
+    for k, (name, (lx0, lx1), (lz0, lz1)) in enumerate(lights):
+        if converted:
+            if k < 2:  # a closed box: emitting bottom, metal housing lying on the ceiling
+                for r in box(lx0, lx1, HEIGHT - 0.06, HEIGHT, lz0, lz1, "metal", "light"):
+                    if r.axis == 1 and r.sign < 0:
+                        r.material = name
+                    rects.append(r)
+            elif k < 4:  # a thin panel hung 0.3 m down, every face of it emitting
+                rects += box(lx0, lx1, HEIGHT - 0.32, HEIGHT - 0.3, lz0, lz1, name, "light")
+            else:  # one downward face just under the ceiling
+                rects.append(Rect(1, HEIGHT - 0.02, -1, lz0, lz1, lx0, lx1, name, "light"))
+            continue
         owner = a_shell if lx0 < A_X[1] else b_shell
         for r in owner:
             if r.axis == 1 and r.sign < 0:
@@ -468,7 +520,7 @@ def build(seed=1):
     # Room A furniture.
     def place(local, angle_deg, pivot):
         """A turned assembly: its polygons and footprints."""
-        p, f = Assembly(local, math.radians(angle_deg), pivot).finish()
+        p, f = Assembly(local, math.radians(angle_deg), pivot, converted).finish()
         polys.extend(p)
         feet.extend(f)
 
@@ -488,8 +540,10 @@ def build(seed=1):
                 if r.axis == 2:
                     sign = -sign
             lo, hi = [r6(c) for c in lo], [r6(c) for c in hi]
-            rects.append(Rect(r.axis, lo[r.axis], sign, lo[u], hi[u], lo[v], hi[v],
-                              r.material, r.tag))
+            moved = Rect(r.axis, lo[r.axis], sign, lo[u], hi[u], lo[v], hi[v], r.material, r.tag)
+            if converted:
+                sink(moved)
+            rects.append(moved)
 
     # Desks in two rows, monitors towards +z (the front wall) in both; chairs behind them.
     put(desk_assembly(), 0.4, -0.15, mirror_z=True)
@@ -536,7 +590,16 @@ def build(seed=1):
         floor.holes.append(hole)
         polys.extend(tris)
 
-    cut_contacts(rects)
+    if converted:
+        # A partition built as two overlapping boxes (their faces inside each other) and a
+        # column through the floor and the ceiling: buried faces, as IFC solids leave them.
+        rects += box(5.2, 5.32, -0.05, 2.0, -3.4, -2.2, "wall_plaster", "partition")
+        rects += box(5.2, 5.32, -0.05, 2.0, -2.6, -1.6, "wall_plaster", "partition")
+        rects += box(3.0, 3.3, -0.1, HEIGHT + 0.1, -0.6, -0.3, "wall_plaster", "column")
+        for r in rects:
+            r.openings = list(r.holes)
+    else:
+        cut_contacts(rects)
     for r in rects:
         polys.extend(rect_polys(r))
     return polys
@@ -639,16 +702,35 @@ def write_mtl(path: Path):
 # Writing the variants.
 
 
-def variant_faces(polys, variant):
-    """The faces (vertex lists, material) of a variant, in writing order."""
+def fan(verts, first=0):
+    """A polygon as fan triangles from its vertex ``first`` (triangles keep its winding)."""
+    if len(verts) == 3:
+        return [verts]
+    vs = verts[first:] + verts[:first]
+    return [[vs[0], vs[k], vs[k + 1]] for k in range(1, len(vs) - 1)]
+
+
+def variant_faces(polys, variant, converted=False):
+    """The faces (vertex lists, material) of a variant, in writing order. Converted: fan
+    triangles, the doubled copy fanned from the next vertex (the other diagonal of a quad);
+    ``mixed`` flips 30 % of the non-emitting polygons (seeded)."""
     out = []
+    rng = random.Random(24)
     for p in polys:
         verts = p.verts
         if variant == "inside-out" and p.tag == "shellB":
             verts = verts[::-1]
-        out.append((verts, p.material))
-        if variant == "doubled":
-            out.append((verts[::-1], p.material))
+        lamp = MATERIALS[p.material][2] is not None
+        if variant == "mixed" and not lamp and rng.random() < 0.3:
+            verts = verts[::-1]
+        if not converted:
+            out.append((verts, p.material))
+            if variant == "doubled":
+                out.append((verts[::-1], p.material))
+            continue
+        out += [(t, p.material) for t in fan(verts)]
+        if variant == "doubled" and not lamp:
+            out += [(t, p.material) for t in fan(verts[::-1], 1)]
     return out
 
 
@@ -679,7 +761,9 @@ def write_obj(path: Path, faces, mtl_name: str, variant: str):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=Path("out/furnished"), help="output folder")
-    ap.add_argument("--variant", choices=VARIANTS + ("all",), default="all")
+    ap.add_argument("--variant", choices=CONVERTED_VARIANTS + ("all",), default="all")
+    ap.add_argument("--style", choices=("clean", "converted", "both"), default="clean",
+                    help="clean (furnished-*.obj) or converted (converted-*.obj): see above")
     ap.add_argument("--seed", type=int, default=1, help="seed of the furniture's variations")
     args = ap.parse_args()
 
@@ -687,13 +771,20 @@ def main():
     for name, img in textures().items():
         (args.out / name).write_bytes(png_bytes(img))
     write_mtl(args.out / "furnished.mtl")
-    polys = build(args.seed)
-    variants = VARIANTS if args.variant == "all" else (args.variant,)
-    for variant in variants:
-        faces = variant_faces(polys, variant)
-        path = args.out / f"furnished-{variant}.obj"
-        write_obj(path, faces, "furnished.mtl", variant)
-        print(f"{path}: {len(faces)} faces")
+    styles = ("clean", "converted") if args.style == "both" else (args.style,)
+    for style in styles:
+        converted = style == "converted"
+        polys = build(args.seed, converted)
+        every = CONVERTED_VARIANTS if converted else VARIANTS
+        variants = every if args.variant == "all" else (args.variant,)
+        for variant in variants:
+            if variant not in every:
+                ap.error(f"--variant {variant} is not made in the {style} style")
+            faces = variant_faces(polys, variant, converted)
+            stem = "converted" if converted else "furnished"
+            path = args.out / f"{stem}-{variant}.obj"
+            write_obj(path, faces, "furnished.mtl", f"converted {variant}" if converted else variant)
+            print(f"{path}: {len(faces)} faces")
 
 
 if __name__ == "__main__":

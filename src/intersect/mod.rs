@@ -9,6 +9,7 @@
 
 pub mod brute;
 pub mod embree;
+pub mod hidden;
 pub mod hybrid;
 pub mod plane_merge;
 pub mod select;

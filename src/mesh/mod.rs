@@ -17,7 +17,13 @@
 //! | `classify.rs`  | axial or skew (Sec. 2)                         |
 //! | `weld.rs`      | welded display vertices, per-vertex values     |
 //! | `sides.rs`     | sides and back twins (docs/design.md §7)       |
+//! | `hidden.rs`    | the sides no light can reach (what was found)  |
+//! | `contact.rs`   | faces lying on faces that face them            |
 
+mod contact;
+mod hidden;
+pub use contact::Contacts;
+pub use hidden::Hidden;
 mod classify;
 mod pieces;
 mod sides;
@@ -89,6 +95,11 @@ pub struct Mesh {
     pub patches: Vec<Patch>,
     /// The patch size used (metres): no patch edge is longer.
     pub patch_size: f32,
+    /// The sides no light can reach (`intersect::hidden`), found once rays can be cast; empty
+    /// until then (no side hidden).
+    pub hidden: Hidden,
+    /// Where faces lie on faces facing them (`Mesh::find_contacts`); empty until found.
+    pub contacts: Contacts,
 }
 
 impl Mesh {
@@ -113,6 +124,10 @@ pub struct MeshOptions {
     pub patch_size: Option<f32>,
     /// Give every polygon a back patch of its own (thin surfaces seen from both sides).
     pub two_sided: bool,
+    /// Keep light that meets the back of a one-sided face absorbed there, as a model's winding
+    /// says, instead of giving the faces lit from behind back patches of their own
+    /// (`pipeline::stages::lit_backs`, the default).
+    pub one_sided: bool,
 }
 
 impl MeshOptions {

@@ -35,6 +35,59 @@ impl Mesh {
         }
     }
 
+    /// Gives every patch of the polygons `polygons` (sorted ids) a back twin of its front
+    /// material, appended after every existing patch, so the surface patches keep their
+    /// indices and the intersectors built over them stay valid: the back patches made where a
+    /// model's winding lets light meet backs (`pipeline::stages::lit_backs`). Patches that are
+    /// already sides of a two-sided surface are left alone. Returns the twins made. Their
+    /// vertices are welded among themselves (within one facing and material), as a builder's.
+    pub fn add_back_twins_for(&mut self, polygons: &[u32]) -> usize {
+        let quantum = (self.patch_size * 1e-4).max(f32::MIN_POSITIVE);
+        let mut weld: HashMap<([i64; 3], [i32; 3], u32), u32> = HashMap::new();
+        let n = self.patches.len();
+        let mut made = 0;
+        for k in 0..n {
+            let front = self.patches[k];
+            if front.side != Side::One || polygons.binary_search(&front.polygon).is_err() {
+                continue;
+            }
+            let ring: Vec<Vec3> = (self.patch_indices(k).iter().rev())
+                .map(|&v| self.vertices[v as usize])
+                .collect();
+            let normal = -front.normal;
+            let q = |x: f32| (x / quantum).round() as i64;
+            let qn = |x: f32| (x * 1000.0).round() as i32;
+            let ids: Vec<u32> = ring
+                .iter()
+                .map(|&p| {
+                    let key = (
+                        [q(p.x), q(p.y), q(p.z)],
+                        [qn(normal.x), qn(normal.y), qn(normal.z)],
+                        front.material,
+                    );
+                    let next = self.vertices.len() as u32;
+                    let id = *weld.entry(key).or_insert(next);
+                    if id == next {
+                        self.vertices.push(p);
+                    }
+                    id
+                })
+                .collect();
+            let twin = self.patches.len() as u32;
+            let first = self.patch_vertices.len() as u32;
+            self.patch_vertices.extend_from_slice(&ids);
+            self.patches.push(Patch {
+                first,
+                normal,
+                side: Side::Back { front: k as u32 },
+                ..front
+            });
+            self.patches[k].side = Side::Front { back: twin };
+            made += 1;
+        }
+        made
+    }
+
     /// How many patches are back twins.
     pub fn back_twins(&self) -> usize {
         (0..self.patches.len())

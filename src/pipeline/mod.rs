@@ -7,6 +7,7 @@
 //! | load      | [`stages::load`]             | the [`Scene`](crate::scene::Scene)   |
 //! | mesh      | [`stages::mesh`]             | the [`Model`] (scene and patches)    |
 //! | intersect | [`stages::intersect`]        | the intersector, if the method casts rays |
+//! | sides     | [`stages::sides`], [`stages::lit_backs`] | the hidden sides and the back patches of faces lit from behind, kept in the mesh |
 //! | solve     | [`stages::solve`]            | the [`Solution`](crate::solve::Solution), read on as [`stages::Solved`] |
 //! | refine    | [`refine::refine`]           | the adaptive elements ([`refine::Refined`]) |
 //! | measure   | [`daylight::measure_grid`]   | the sensor grid ([`daylight::Measured`]) |
@@ -228,12 +229,17 @@ fn solve_into(
     timings.load = t0.elapsed().as_secs_f64();
 
     let clock = Clock::start();
-    let model = stages::mesh(job, scene, progress, log)?;
+    let mut model = stages::mesh(job, scene, progress, log)?;
     timings.mesh = clock.seconds();
 
     let clock = Clock::start();
     let isect = stages::intersect(job, &model, progress, log)?;
     timings.build = clock.seconds();
+
+    let clock = Clock::start();
+    stages::sides(job, &mut model, isect.as_ref(), progress, log);
+    let lit_backs = stages::lit_backs(job, &mut model, isect.as_ref(), progress, log)?;
+    timings.sides = clock.seconds();
 
     let hooks = hooks::build(job, &model, log)?;
     let clock = Clock::start();
@@ -249,6 +255,7 @@ fn solve_into(
         sky: stages::sky(job),
         t0,
         progress,
+        lit_backs,
     };
     // The elements and the gathered picture cast rays: through the solve's intersector, or
     // one built for them (the methods that cast none).

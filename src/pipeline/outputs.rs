@@ -221,6 +221,11 @@ fn summary(
         hemicube_n: s.method.uses_uniform_cube().then_some(s.hemicube_n),
         switch: sol.stats.switch,
         final_gather: sol.stats.final_gather,
+        hidden: {
+            let (patches, area_m2) = m.hidden.count(m);
+            report::HiddenReport { patches, area_m2 }
+        },
+        lit_backs: solved.lit_backs,
         elements: None,
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
         cpu_seconds: timings.cpu,

@@ -8,7 +8,7 @@ use crate::intersect::select::{AnyIntersector, Selection};
 use crate::intersect::Intersector;
 use crate::model::Model;
 use crate::progress::Progress;
-use crate::report::{self, Summary};
+use crate::report::{self, LitBacks, Summary};
 use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::solve::{RunHooks, Solution, TracePoint};
@@ -31,6 +31,8 @@ pub struct Solved<'a> {
     pub t0: Instant,
     /// The bars (the elements and the gathered picture have theirs).
     pub progress: &'a Progress,
+    /// What [`lit_backs`] did, when it ran.
+    pub lit_backs: Option<LitBacks>,
 }
 
 /// Wall and CPU time of one stage.
@@ -117,6 +119,110 @@ pub fn intersect(
         log(&format!("intersector {}: {}", isect.name(), chosen.reason));
     }
     Ok(isect)
+}
+
+/// Sides: finds the sides no light can reach (`intersect::hidden`), when the method casts
+/// rays, and logs how many there are. They are kept in the mesh for the stages after.
+pub fn sides(
+    job: &SolveJob,
+    model: &mut Model,
+    isect: Option<&(AnyIntersector, Selection)>,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+) {
+    let Some((isect, _)) = isect else { return };
+    progress.phase("finding hidden faces");
+    model.mesh.contacts = model.mesh.find_contacts();
+    model.find_hidden(isect, job.settings.solve.seed);
+    let (n, area) = model.mesh.hidden.count(&model.mesh);
+    if n > 0 {
+        log(&format!(
+            "hidden: {n} patches ({area:.2} m²) inside closed solids or under other faces: no light reaches them, no rays are spent on them"
+        ));
+    }
+}
+
+/// Light that met backs below this share of the emitted light is left absorbed there (a
+/// closed, consistently wound model leaks about 1e-5 at its creases).
+pub const LIT_BACKS_MIN: f64 = 1e-3;
+/// Back patches are made for the polygons lit from behind, the most lit first, until what
+/// meets the remaining backs is below this share of the emitted light.
+pub const LIT_BACKS_LEFT: f64 = 2e-4;
+
+/// Lit backs: unless the mesh is two-sided or `--one-sided` is asked for, a first shooting
+/// (no final gather, no error target, the tolerance at least 0.15: about a ninth of the rays)
+/// finds where light meets the back of a one-sided face — a model wound both ways, a room
+/// inside out — and the polygons lit so get back patches of their own (appended, so the
+/// intersector stays valid), as Radiance, whose surfaces are all two-sided, sees them. Rays
+/// that left a covered part of their shooter are not cast (`crate::mesh::Contacts`) or carry
+/// nothing (`crate::mesh::Hidden`), so they make no back patches. The hidden sides are probed
+/// again once the back patches exist. The solve proper runs after, on the new mesh.
+pub fn lit_backs(
+    job: &SolveJob,
+    model: &mut Model,
+    isect: Option<&(AnyIntersector, Selection)>,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+) -> Result<Option<LitBacks>, Error> {
+    let s = &job.settings;
+    let Some((isect, _)) = isect else {
+        return Ok(None);
+    };
+    if s.mesh.two_sided || s.mesh.one_sided || !s.solve.method.casts_rays() {
+        return Ok(None);
+    }
+    progress.phase("looking for faces lit from behind");
+    let t = Instant::now();
+    let probe = crate::solve::SolveSettings {
+        tolerance: s.solve.tolerance.max(0.15),
+        energy_per_ray: None,
+        error_target: None,
+        final_gather: false,
+        ..s.solve.clone()
+    };
+    let sol = model.solve(Some(isect), &probe, &Default::default(), |_| {})?;
+    let emitted = crate::solve::scalar(&sol.stats.energy.emitted).max(f64::MIN_POSITIVE);
+    let mesh = &model.mesh;
+    let mut per_polygon: std::collections::BTreeMap<u32, f64> = Default::default();
+    for (i, &phi) in sol.back.iter().enumerate() {
+        let p = &mesh.patches[i];
+        let m = &model.scene.materials[p.material as usize];
+        if phi > 0.0 && !m.is_emitter() {
+            *per_polygon.entry(p.polygon).or_default() += phi;
+        }
+    }
+    let total: f64 = per_polygon.values().sum();
+    let mut out = LitBacks {
+        back_fraction: total / emitted,
+        ..LitBacks::default()
+    };
+    if total >= LIT_BACKS_MIN * emitted {
+        let mut ranked: Vec<(u32, f64)> = per_polygon.into_iter().collect();
+        ranked.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+        let mut left = total;
+        let mut chosen = Vec::new();
+        for (poly, phi) in ranked {
+            if left < LIT_BACKS_LEFT * emitted {
+                break;
+            }
+            chosen.push(poly);
+            left -= phi;
+        }
+        chosen.sort_unstable();
+        out.polygons = chosen.len();
+        out.patches = model.mesh.add_back_twins_for(&chosen);
+        // The new back patches are sides light reaches: probe again with them in place (a
+        // room wound inside out looked closed from inside before).
+        model.find_hidden(isect, s.solve.seed);
+        log(&format!(
+            "lit from behind: {:.1} % of the light met the backs of one-sided faces in a first shooting; {} faces given back patches ({} patches; --one-sided to keep them one-sided)",
+            100.0 * out.back_fraction,
+            out.polygons,
+            out.patches
+        ));
+    }
+    out.seconds = t.elapsed().as_secs_f64();
+    Ok(Some(out))
 }
 
 /// Solve: runs the method with the job's hooks (reference, per-light channels, checkpoints,

@@ -240,6 +240,8 @@ pub struct Timings {
     pub load: f64,
     pub mesh: f64,
     pub build: f64,
+    /// Finding the hidden sides (`intersect::hidden`).
+    pub sides: f64,
     pub solve: f64,
     pub output: f64,
     /// Of `output`: measuring the sensor grid (`--grid`).
@@ -295,6 +297,28 @@ impl From<&EnergyBalance> for EnergyReport {
     }
 }
 
+/// The faces a first shooting found lit from behind and gave back patches
+/// (`pipeline::stages::lit_backs`; `summary.json`: `lit_backs`).
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct LitBacks {
+    /// Share of the emitted light that met the back of a one-sided face (not a hidden one) in
+    /// the first shooting.
+    pub back_fraction: f64,
+    /// Polygons given back patches, and the back patches made.
+    pub polygons: usize,
+    pub patches: usize,
+    /// Wall seconds of the first shooting.
+    pub seconds: f64,
+}
+
+/// Sides no light can reach (`mesh::Hidden`; `summary.json`: `hidden`): the patches whose side
+/// is hidden, and their area. They are black, and kept out of the black-patch counts.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct HiddenReport {
+    pub patches: usize,
+    pub area_m2: f64,
+}
+
 /// The JSON summary of a solve (`summary.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -332,6 +356,12 @@ pub struct Summary {
     /// The final gather after the shooting (patches gathered, rays, seconds, black patches
     /// before and after), when one ran; `rays` above are the shooting's.
     pub final_gather: Option<crate::solve::final_gather::GatherStats>,
+    /// Patches whose side no light can reach (inside closed solids, under other faces).
+    pub hidden: HiddenReport,
+    /// The back patches made for faces lit from behind (absent with `--two-sided`,
+    /// `--one-sided`, or a method that casts no rays).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lit_backs: Option<LitBacks>,
     /// The adaptive elements refined after the solve (count, rays, seconds), when they were
     /// (`--elements auto`, the default, or `on`).
     #[serde(skip_serializing_if = "Option::is_none")]

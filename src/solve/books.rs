@@ -121,6 +121,9 @@ pub(super) struct State {
     cube_kept: Vec<f64>,
     cube_var: Vec<f64>,
     pub channels: Option<Channels>,
+    /// Scalar flux that met the back of each one-sided surface patch (W): where the model's
+    /// winding loses light (`Solution::back`). Empty until a ray meets a back.
+    pub back: Vec<f64>,
 }
 
 /// What a checkpoint keeps of the books (`State::save`, `State::restore`): every
@@ -192,6 +195,7 @@ impl State {
             cube_kept: Vec::new(),
             cube_var: Vec::new(),
             channels: None,
+            back: Vec::new(),
         };
         let mut rho_area = 0.0;
         for (p, s) in mesh.patches.iter().zip(&st.patches) {
@@ -400,10 +404,27 @@ impl State {
         }
     }
 
-    /// Flux that arrived on a back face (absorbed there).
+    /// Flux that arrived on the back of one-sided patch `j` (absorbed there).
     #[inline]
-    pub fn deposit_back(&mut self, phi: &[f64; 3]) {
+    pub fn deposit_back(&mut self, j: usize, phi: &[f64; 3]) {
         add3(&mut self.energy.absorbed_back, phi);
+        self.note_back(j, phi);
+    }
+
+    /// Flux absorbed on back faces with no patch to name (a shot from a covered part whose
+    /// every ray was covered).
+    #[inline]
+    pub fn absorb_back(&mut self, phi: &[f64; 3]) {
+        add3(&mut self.energy.absorbed_back, phi);
+    }
+
+    /// Records where light met a back ([`Self::back`]).
+    #[inline]
+    fn note_back(&mut self, j: usize, phi: &[f64; 3]) {
+        if self.back.is_empty() {
+            self.back = vec![0.0; self.patches.len()];
+        }
+        self.back[j] += scalar(phi);
     }
 
     /// A distant emitter (a sky piece, the sun: [`super::sky_shots`]) shoots `phi`: emitted,
@@ -417,9 +438,10 @@ impl State {
     /// Flux from a distant emitter that arrived on a back face (absorbed there): a one-sided
     /// model's outside, not a winding error.
     #[inline]
-    pub fn deposit_back_distant(&mut self, phi: &[f64; 3]) {
+    pub fn deposit_back_distant(&mut self, j: usize, phi: &[f64; 3]) {
         add3(&mut self.energy.absorbed_back, phi);
         add3(&mut self.energy.distant_back, phi);
+        self.note_back(j, phi);
     }
 
     /// A distant emitter's ray that missed the model.

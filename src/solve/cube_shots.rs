@@ -22,7 +22,7 @@
 
 use super::books::State;
 use super::{rng_for, Stream};
-use crate::mesh::Mesh;
+use crate::mesh::{Hidden, Mesh};
 use crate::sample::hemicube::{Hemicube, HemicubeBuffer, ShotWork};
 use crate::sample::Frame;
 use rand::Rng;
@@ -158,15 +158,32 @@ impl CubeShooter {
     }
 }
 
-/// Applies one shot: j receives ΔΦ_i·F_ij; what no cell saw escapes.
-pub(super) fn apply(st: &mut State, shot: &CubeShot, hits: &CubeHits) {
+/// Applies one shot: j receives ΔΦ_i·F_ij; what no cell saw escapes. Cells that see a hidden
+/// back (`mesh::Hidden`: the cube's centre is covered from there, inside a solid) carry
+/// nothing, the other cells' factors scaled up by 1 / (1 − their share), unless every cell is
+/// covered (then the shot is absorbed on those backs, as before the test).
+pub(super) fn apply(st: &mut State, shot: &CubeShot, hits: &CubeHits, hidden: &Hidden) {
+    let is_covered = |j: u32, back: bool| back && hidden.back_of(j as usize);
+    let covered: f64 = (hits.ff.iter())
+        .filter(|&&(j, _, back)| is_covered(j, back))
+        .map(|&(_, f, _)| f)
+        .sum();
+    let scale = if covered > 0.0 && covered < 1.0 - 1e-9 {
+        1.0 / (1.0 - covered)
+    } else {
+        1.0
+    };
     let mut seen = 0.0;
     // Cells carry ΔΦ/cells on average (equal ΔF for the non-uniform cube).
     let e_cell = super::scalar(&shot.phi) / shot.cube.cell_count() as f64;
     for &(j, f, back) in &hits.ff {
+        if scale != 1.0 && is_covered(j, back) {
+            continue;
+        }
+        let f = f * scale;
         let phi = shot.phi.map(|p| p * f);
         if back {
-            st.deposit_back(&phi);
+            st.deposit_back(j as usize, &phi);
         } else {
             st.deposit_cube(j as usize, &phi, e_cell);
             if !shot.ch.is_empty() {

@@ -240,6 +240,8 @@ pub(super) struct PatchScalars {
     rho_mean: f64,
     /// Sides of two-sided surfaces (empty if the mesh has none).
     other_side: Vec<u32>,
+    /// Hidden sides (empty if none is: `crate::mesh::Hidden`).
+    hidden: Vec<bool>,
 }
 
 impl PatchScalars {
@@ -257,8 +259,16 @@ impl PatchScalars {
         } else {
             Vec::new()
         };
+        let hidden = if mesh.hidden.count(mesh).0 > 0 {
+            (0..mesh.patches.len())
+                .map(|i| mesh.hidden.side(mesh, i))
+                .collect()
+        } else {
+            Vec::new()
+        };
         PatchScalars {
             other_side,
+            hidden,
             emission: mesh
                 .patches
                 .iter()
@@ -278,6 +288,7 @@ impl PatchScalars {
             energy_per_ray,
             rho_mean: self.rho_mean,
             other_side: &self.other_side,
+            hidden: &self.hidden,
         }
     }
 }
@@ -656,7 +667,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             shooter.cast(self.mesh, self.cfg.seed, &wave, &mut self.cube_hits);
             for (shot, h) in wave.iter().zip(&self.cube_hits) {
                 self.switch.record(shot.cube.cell_count(), h);
-                cube_shots::apply(&mut self.st, shot, h);
+                cube_shots::apply(&mut self.st, shot, h, &self.mesh.hidden);
             }
             self.st.finish_batch();
             self.stats.hemicube_shots += wave.len() as u64;
@@ -749,6 +760,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             stats,
             channels,
             shooting: None,
+            back: std::mem::take(&mut st.back),
         }
     }
 }

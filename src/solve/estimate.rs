@@ -86,6 +86,9 @@ pub struct Estimator<'a> {
     /// object (what reaches it leaks through cracks where parts touch): it is owed nothing and
     /// its relative error is not counted. One-sided patches are always owed their share.
     pub other_side: &'a [u32],
+    /// Per patch: its own side is hidden (`crate::mesh::Hidden`: inside a closed solid); empty
+    /// when none is. A hidden side that has received nothing is dark: owed nothing, not counted.
+    pub hidden: &'a [bool],
 }
 
 /// A side of a two-sided surface that has received at most this share of what its other side
@@ -152,9 +155,10 @@ impl Estimator<'_> {
         let n = self.area.len();
         let dark = |j: usize| {
             let o = self.other_side.get(j).copied().unwrap_or(u32::MAX);
-            o != u32::MAX
-                && self.emission[j] <= 0.0
-                && books.gathered[j] <= DARK_SIDE * books.gathered[o as usize]
+            let hidden = self.hidden.get(j).copied().unwrap_or(false);
+            self.emission[j] <= 0.0
+                && ((o != u32::MAX && books.gathered[j] <= DARK_SIDE * books.gathered[o as usize])
+                    || (hidden && books.gathered[j] <= 0.0))
         };
         let rho_area: f64 = (0..n)
             .filter(|&j| !dark(j))
@@ -232,6 +236,7 @@ mod tests {
             energy_per_ray: 0.01,
             rho_mean: 0.5,
             other_side: &[],
+            hidden: &[],
         };
         // 100 hits of 0.01 W kept at ρ = 0.5: G = 0.5, Var = 0.5·0.01·0.5, σ/B = 0.1.
         let books = Books {
@@ -269,6 +274,7 @@ mod tests {
             energy_per_ray: 0.0,
             rho_mean: 0.5,
             other_side: &[1, 0],
+            hidden: &[],
         };
         let books = Books {
             gathered: &[0.5, 0.0],
@@ -285,6 +291,7 @@ mod tests {
         // One-sided, the unlit patch is owed half the light.
         let m = Estimator {
             other_side: &[],
+            hidden: &[],
             ..est
         }
         .metrics(&books);

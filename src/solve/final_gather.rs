@@ -20,7 +20,8 @@
 //! scalar sample variance of the mean. This module decides which patches gather, with how
 //! many rays and rounds, and how the gather's estimate is combined with the shooting's.
 //!
-//! **Which patches**: every patch that reflects (ρ > 0), but dark sides (below). Gathering only
+//! **Which patches**: every patch that reflects (ρ > 0), but dark sides (below) and hidden
+//! sides the shooting left black (inside closed solids: `crate::mesh::Hidden`). Gathering only
 //! the patches the shooting left noisier than the tolerance (the first design) left the bias of
 //! constant patches in place where the shooting was precise: on the project's furnished office
 //! (`scripts/radiance`), a shelf back 5 cm from a wall came out at 2.7× Radiance's irradiance
@@ -298,7 +299,7 @@ pub fn apply<I: Intersector>(
     let t0 = Instant::now();
     let (e, rho) = emission_and_reflectance(inp.mesh, inp.materials);
     let area: Vec<f64> = inp.mesh.patches.iter().map(|p| p.area).collect();
-    let black_before = black(&sol.b, &e, &rho);
+    let black_before = black(&sol.b, &e, &rho, inp.mesh);
     let mut gathers = {
         let solved = Solved {
             e: Cow::Borrowed(&e),
@@ -322,7 +323,7 @@ pub fn apply<I: Intersector>(
         rays: gathers.rays(),
         seconds: gathers.seconds,
         black_before,
-        black_after: black(&c.b, &e, &rho),
+        black_after: black(&c.b, &e, &rho, inp.mesh),
         rejected: c.rejected,
         mean_shooting_weight: if todo_len == 0 {
             1.0
@@ -363,10 +364,12 @@ fn reflected(b: &[[f64; 3]], e: &[Rgb], i: usize) -> f64 {
     scalar(&b[i]) - light::scalar(e[i])
 }
 
-/// Patches with ρ > 0 and no reflected light at all by `b`.
-fn black(b: &[[f64; 3]], e: &[Rgb], rho: &[Rgb]) -> u64 {
+/// Patches with ρ > 0 and no reflected light at all by `b`, but hidden sides
+/// ([`crate::mesh::Hidden`]: black because no light can reach them, counted apart).
+fn black(b: &[[f64; 3]], e: &[Rgb], rho: &[Rgb], mesh: &Mesh) -> u64 {
     (0..b.len())
         .filter(|&i| light::scalar(rho[i]) > 0.0 && reflected(b, e, i) <= 0.0)
+        .filter(|&i| !mesh.hidden.side(mesh, i))
         .count() as u64
 }
 
@@ -387,8 +390,11 @@ fn first_round<I: Intersector>(
             other > 0.0 && reflected(&sol.b, e, i) <= estimate::DARK_SIDE * other
         })
     };
+    // A hidden side (inside a closed solid, `crate::mesh::Hidden`) the shooting brought no
+    // light: none can reach it, so no rays are cast for it.
+    let hidden = |i: usize| mesh.hidden.side(mesh, i) && reflected(&sol.b, e, i) <= 0.0;
     let todo: Vec<usize> = (0..mesh.patches.len())
-        .filter(|&i| !faces_void(i) && light::scalar(rho[i]) > 0.0)
+        .filter(|&i| !faces_void(i) && !hidden(i) && light::scalar(rho[i]) > 0.0)
         .collect();
     let got: Vec<Gathered> = todo
         .par_iter()

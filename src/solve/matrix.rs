@@ -350,6 +350,7 @@ pub fn solve(
         stats,
         channels,
         shooting: None,
+        back: Vec::new(),
     }
 }
 

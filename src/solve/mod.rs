@@ -242,6 +242,9 @@ pub struct Solution {
     /// With an error target: the shooting's own result before any final gather, and its error
     /// estimate's parts per patch, for [`passes`] to combine passes by (`None` otherwise).
     pub shooting: Option<Box<ShotResult>>,
+    /// Scalar flux that met the back of each one-sided surface patch (W; the shooting's,
+    /// of its last pass): where the winding lost light. Empty when none did.
+    pub back: Vec<f64>,
 }
 
 /// A shooting pass's radiosity (before any final gather) and its error estimate's parts.

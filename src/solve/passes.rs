@@ -190,7 +190,7 @@ fn combine(
     for j in 0..n {
         let dark = mesh.other_side(j).is_some_and(|o| {
             emission[j] <= 0.0 && reflected(j) <= estimate::DARK_SIDE * reflected(o)
-        });
+        }) || (emission[j] <= 0.0 && reflected(j) <= 0.0 && mesh.hidden.side(mesh, j));
         if dark {
             (missing[j], sigma[j], b_est[j]) = (0.0, 0.0, 0.0);
         }

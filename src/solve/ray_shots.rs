@@ -29,6 +29,9 @@ pub const CHUNK: usize = 1024;
 /// Hit codes: a patch id, a patch id with this bit for a back-face hit, or [`ESCAPED`].
 pub(super) const BACK: u32 = 1 << 31;
 pub(super) const ESCAPED: u32 = u32::MAX;
+/// Hit code of a ray that met a hidden back (`mesh::Hidden`): it left a covered part of its
+/// shooter (the floor under a cabinet), so it carries none of the shot's light.
+pub(super) const COVERED: u32 = u32::MAX - 1;
 /// Surfaces a ray may step past (its own, glazing) before it is taken as lost.
 const MAX_STEPS: usize = 16;
 
@@ -86,6 +89,9 @@ pub(super) struct RayCaster<'a, I> {
     /// The factor T_c / T per patch a ray going through it carries its energy on with
     /// (`Material::tint`); empty when no glazing is tinted.
     tint: Vec<[f64; 3]>,
+    /// Which patches emit (their rays are never taken as leaving a covered point: light in an
+    /// enclosure is in a room wound inside out, not inside a solid); empty: none known.
+    lights: Vec<bool>,
 }
 
 /// The rays of one chunk: a hit code per ray, and which of them went through tinted glazing.
@@ -137,6 +143,7 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
             eps_floor: reach * 5e-7,
             trans: Vec::new(),
             tint: Vec::new(),
+            lights: Vec::new(),
         }
     }
 
@@ -153,6 +160,12 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
     pub fn with_glazing(mut self, materials: &[crate::scene::Material]) -> Self {
         let mat = |p: &crate::mesh::Patch| &materials[p.material as usize];
         let t = |p: &crate::mesh::Patch| mat(p).transmittance as f32;
+        self.lights = self
+            .mesh
+            .patches
+            .iter()
+            .map(|p| mat(p).is_emitter())
+            .collect();
         if self.mesh.patches.iter().any(|p| t(p) > 0.0) {
             self.trans = self.mesh.patches.iter().map(t).collect();
         }
@@ -184,9 +197,17 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
         };
         // The shooter's surface: a back twin's rays leave the surface its front patch is.
         let own = Some(self.mesh.surface_of(i));
+        // Points of a front under a face lying on it (`mesh::Contacts`) send no light.
+        let light = self.lights.get(i).copied().unwrap_or(false);
+        let contacts = !light && self.mesh.is_surface(i) && !self.mesh.contacts.is_empty();
         for k in first..first + count {
             let dir = frame.to_world(shot.grid.direction(k, 0.0, self.jitter, &mut rng));
-            let org = points.sample(&mut rng) + patch.normal * eps;
+            let at = points.sample(&mut rng);
+            if contacts && self.mesh.contacts.covers(i, at) {
+                out.codes.push(COVERED);
+                continue;
+            }
+            let org = at + patch.normal * eps;
             let (code, tint) = self.trace(own, org, dir, eps, &mut rng);
             if let Some(t) = tint {
                 out.tinted.push(((k - first) as u32, t));
@@ -232,10 +253,16 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
                 }
                 // The side met decides the receiver (docs/design.md §7).
                 Some(h) => {
-                    let code = self
-                        .mesh
-                        .receiver(h.patch, h.back)
-                        .unwrap_or(h.patch | BACK);
+                    let code = match self.mesh.receiver(h.patch, h.back) {
+                        Some(r) => r,
+                        None if own
+                            .is_some_and(|o| !self.lights.get(o).copied().unwrap_or(false))
+                            && self.mesh.hidden.back_of(h.patch as usize) =>
+                        {
+                            COVERED
+                        }
+                        None => h.patch | BACK,
+                    };
                     return (code, tint);
                 }
             }
@@ -287,17 +314,35 @@ pub fn time_ray_shots<I: Intersector>(
 
 /// Applies a wave's hits in task order: receivers gain ρ_j·ΔΦ_i/X, the rest is absorbed.
 /// A ray that went through tinted glazing carries ΔΦ_i/X times its tint factor.
+/// Rays that met a hidden back ([`COVERED`]) carry nothing: a shot's flux goes out through its
+/// other rays (all of them covered: the shot's flux is absorbed on the back faces).
 pub(super) fn apply_rays(st: &mut State, wave: &[RayShot], tasks: &[Task], hits: &[Hits]) {
+    let mut covered = vec![0usize; wave.len()];
+    for (task, hits) in tasks.iter().zip(hits) {
+        covered[task.shot] += hits.codes.iter().filter(|&&c| c == COVERED).count();
+    }
     for (task, hits) in tasks.iter().zip(hits) {
         let shot = &wave[task.shot];
-        let per_ray = 1.0 / shot.grid.len() as f64;
+        let x = shot.grid.len();
+        let all_covered = covered[task.shot] == x;
+        let per_ray = 1.0
+            / (if all_covered {
+                x
+            } else {
+                x - covered[task.shot]
+            }) as f64;
         let phi_ray = shot.phi.map(|p| p * per_ray);
         for (code, tint) in hits.iter() {
+            if code == COVERED && !all_covered {
+                continue;
+            }
             let phi = carried(st, &phi_ray, tint);
-            if code == ESCAPED {
+            if code == COVERED {
+                st.absorb_back(&phi);
+            } else if code == ESCAPED {
                 st.escape(&phi);
             } else if code & BACK != 0 {
-                st.deposit_back(&phi);
+                st.deposit_back((code & !BACK) as usize, &phi);
             } else {
                 st.deposit(code as usize, &phi);
                 if !shot.ch.is_empty() {

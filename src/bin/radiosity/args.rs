@@ -30,8 +30,13 @@ pub struct SceneArgs {
     pub patch_size: Option<f32>,
     /// Make every polygon two-sided: a back patch of its own, lit from behind (thin surfaces;
     /// models with mixed winding). Lights still shine from their front only.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "one_sided")]
     pub two_sided: bool,
+    /// Keep every face one-sided as its winding says: light meeting a back is absorbed there.
+    /// By default the faces that light meets from behind (mixed winding, rooms inside out) get
+    /// back patches of their own, found by a quick first shooting.
+    #[arg(long)]
+    pub one_sided: bool,
     /// Turn every polygon round: for models wound clockwise (rooms inside out, lights facing
     /// away from them).
     #[arg(long)]
@@ -49,6 +54,7 @@ impl SceneArgs {
         MeshOptions {
             patch_size: self.patch_size,
             two_sided: self.two_sided,
+            one_sided: self.one_sided,
         }
     }
 }

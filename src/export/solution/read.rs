@@ -155,6 +155,7 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
         patch_vertices,
         patches,
         patch_size: meta.patch_size,
+        ..Mesh::default()
     };
     let elements = match sections.get(b"ELEM") {
         None => None,
@@ -166,6 +167,7 @@ fn parse_payload(payload: &[u8]) -> Result<SavedSolution, String> {
                 patch_vertices: records(get(b"EIDX")?, 4, "EIDX", |c| c.u32())?,
                 patches: read_records(el, "ELEM")?,
                 patch_size: meta.patch_size,
+                ..Mesh::default()
             };
             let patch = records(get(b"EPAT")?, 4, "EPAT", |c| c.u32())?;
             let vb = records(get(b"EVRD")?, 12, "EVRD", |c| c.f32x3())?;
