@@ -245,6 +245,7 @@ mod tests {
                 side: Side::One,
             }],
             patch_size: 1.0,
+            ..Mesh::default()
         }
     }
 

@@ -41,6 +41,7 @@ fn opts(size: f32) -> MeshOptions {
     MeshOptions {
         patch_size: Some(size),
         two_sided: false,
+        one_sided: false,
     }
 }
 
@@ -137,6 +138,7 @@ fn two_sided_adds_opposite_patches_with_their_own_vertices() {
         &MeshOptions {
             patch_size: Some(0.5),
             two_sided: true,
+            one_sided: false,
         },
     );
     assert_eq!(m.patches.len(), 8);
@@ -196,6 +198,7 @@ fn an_emitter_stays_one_sided_and_a_merged_back_material_is_used() {
     let two = MeshOptions {
         patch_size: Some(1.0),
         two_sided: true,
+        one_sided: false,
     };
     let m = build(&s, &two);
     assert_eq!(m.patches.len(), 3, "lamp one-sided, the other two-sided");

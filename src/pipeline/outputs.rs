@@ -46,7 +46,7 @@ fn solution_warnings(energy: &EnergyReport, backs_meet: f64) -> Vec<String> {
     // docs/design.md §7: a model with wrong winding never gives a silent black image.
     if energy.back_fraction > BACK_WARNING {
         w.push(format!(
-            "{:.1} % of the emitted light met the back of one-sided faces and was lost there (faces wound clockwise: an inside-out room, or mixed winding): solve with --two-sided",
+            "{:.1} % of the emitted light met the back of one-sided faces and was lost there (faces wound clockwise: an inside-out room, or mixed winding): solve without --one-sided, or with --two-sided",
             100.0 * energy.back_fraction
         ));
     }

@@ -23,6 +23,7 @@ fn office() -> (Scene, Mesh) {
         &MeshOptions {
             patch_size: Some(0.6),
             two_sided: false,
+            one_sided: false,
         },
     );
     (s, m)

@@ -301,6 +301,7 @@ fn flipped_normals_are_reported() {
         out.to_str().unwrap(),
         "--patch-size",
         "0.25",
+        "--one-sided",
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(

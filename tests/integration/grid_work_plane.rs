@@ -35,6 +35,7 @@ fn mesh(s: &Scene, two_sided: bool) -> Mesh {
         &MeshOptions {
             patch_size: Some(1.0),
             two_sided,
+            one_sided: false,
         },
     )
 }

@@ -10,6 +10,7 @@ mod bad_input;
 mod checkpoint;
 mod cli;
 mod compare;
+mod converted;
 mod daylight;
 mod elements;
 mod error_target;

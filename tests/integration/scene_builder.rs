@@ -138,6 +138,7 @@ pub fn mesh_at(scene: &Scene, patch_size: Option<f32>) -> Mesh {
         &MeshOptions {
             patch_size,
             two_sided: false,
+            one_sided: false,
         },
     )
 }

@@ -332,6 +332,7 @@ const SHAPING: &[Shaping] = &[
     shaping("emit", &["--emit", "light=1,2,3"], &[]),
     shaping("patch-size", &["--patch-size", "0.5"], &[]),
     shaping("two-sided", &["--two-sided"], &[]),
+    shaping("one-sided", &["--one-sided"], &[]),
     shaping("flip", &["--flip"], &[]),
     shaping("seed", &["--seed", "7"], &[]),
     shaping("tolerance", &["--tolerance", "0.1"], &[]),

@@ -14,6 +14,7 @@ fn sample() -> SavedSolution {
         patch_vertices: vec![0, 1, 2, 3],
         patches: Vec::new(),
         patch_size: 1.0,
+        ..Mesh::default()
     };
     mesh.patches.push(Patch {
         first: 0,

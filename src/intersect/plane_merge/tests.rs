@@ -31,6 +31,7 @@ fn two_quads() -> Mesh {
         patch_vertices: vec![0, 1, 4, 3, 1, 2, 5, 4],
         patches: vec![quad(0, 0.5), quad(4, 1.5)],
         patch_size: 1.0,
+        ..Mesh::default()
     }
 }
 
