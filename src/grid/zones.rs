@@ -5,10 +5,13 @@
 //! # Indoors
 //!
 //! A sensor is **indoors** when something covers it: of five rays cast up from it (the zenith
-//! and four tilted [`CONE_DEGREES`] towards east, north, west and south), at least three meet a
-//! surface within [`OUTDOOR_REACH`]. Any surface counts, glazing too: a floor under a roof
-//! light (an atrium, a conservatory) is indoors. The majority makes one ray slipping through a
-//! crack between two faces, or grazing the edge of an eave, change nothing. A sensor under an
+//! and four tilted [`CONE_DEGREES`] towards north-east, north-west, south-west and south-east),
+//! at least three meet a surface within [`OUTDOOR_REACH`]. Any surface counts, glazing too: a
+//! floor under a roof light (an atrium, a conservatory) is indoors. The majority makes one ray
+//! slipping through a crack between two faces, or grazing the edge of an eave, change nothing;
+//! the tilts lean across the lattice's lines, so even a crack running along the line of a row
+//! or column of sensors (where joins of a modelled grid of roof panels may fall) lets only the
+//! zenith ray through. A sensor under an
 //! overhang (a porch, a balcony above, a carport) is covered and so counts as indoors.
 //!
 //! # Storeys
@@ -102,13 +105,9 @@ pub fn indoor<I: Intersector>(isect: &I, compass: &Compass, sensors: &[Sensor]) 
     let (s, c) = (CONE_DEGREES as f64).to_radians().sin_cos();
     let dirs: Vec<Vec3> = std::iter::once(up)
         .chain(
-            [
-                compass.east(),
-                compass.north(),
-                -compass.east(),
-                -compass.north(),
-            ]
-            .map(|h| c * up + s * h),
+            [(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)]
+                .map(|(e, n)| (e * compass.east() + n * compass.north()).normalize())
+                .map(|h| c * up + s * h),
         )
         .map(|d| d.normalize().as_vec3())
         .collect();

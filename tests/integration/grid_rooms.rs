@@ -363,3 +363,30 @@ fn grid_glazing_overhead_is_indoors_and_a_roofless_model_keeps_its_sensors() {
     // Asked to keep them, nothing to warn of.
     assert_eq!(placed(&s, Outdoor::Keep).warning, None);
 }
+
+#[test]
+fn grid_a_crack_in_the_roof_over_a_row_of_sensors_leaves_them_indoors() {
+    // The house's roof in two slabs with a 2 cm gap along x = 1.5, right over the column of
+    // sensors there: their zenith rays escape through it, the tilted ones do not.
+    let mut s = scene("cracked", materials());
+    level(&mut s, (0.0, 8.0), (0.0, 6.0), 0.0, true, GROUND);
+    storey(&mut s, 0.0);
+    block(&mut s, vec3(0.0, 2.7, 0.0), vec3(1.49, 2.9, 6.0), WALL);
+    block(&mut s, vec3(1.51, 2.7, 0.0), vec3(8.0, 2.9, 6.0), WALL);
+    let p = placed(&s, Outdoor::Keep);
+    let under: Vec<_> = p
+        .sensors
+        .iter()
+        .zip(&p.zones)
+        .filter(|(s, _)| (s.position.x - 1.5).abs() < 1e-4 && s.position.y < 1.0)
+        .collect();
+    assert_eq!(under.len(), 6);
+    assert!(
+        under.iter().all(|(_, z)| z.indoor && z.room == 1),
+        "{under:?}"
+    );
+    // Only the roof's sensors are outdoors (none over the crack): no sensor of the rooms is
+    // lost.
+    assert_eq!(p.outdoor_points, 48 - 6);
+    assert_eq!(p.zones.iter().filter(|z| z.indoor).count(), 48);
+}
