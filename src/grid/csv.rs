@@ -5,7 +5,7 @@
 //! mark tolerated. A file written by [`write_csv`] reads back with [`read_points`] to the same
 //! sensors, bit for bit, so a grid can be reused for another sky or another design.
 
-use super::{GridError, Sensor};
+use super::{GridError, Sensor, Zone};
 use glam::Vec3;
 use std::io::Write;
 use std::path::Path;
@@ -13,8 +13,10 @@ use std::path::Path;
 /// The columns [`read_points`] needs, in the order of [`Sensor`]'s fields.
 const NEEDED: [&str; 6] = ["x", "y", "z", "nx", "ny", "nz"];
 
-/// The header [`write_csv`] writes: position, facing, illuminance (lux), daylight factor (%).
-pub const CSV_HEADER: &str = "x,y,z,nx,ny,nz,lux,df";
+/// The header [`write_csv`] writes: position, facing, illuminance (lux), daylight factor (%),
+/// then where the sensor is ([`Zone`]): its storey (from 0), its room (from 1 within the
+/// storey, 0 for none) and whether it is indoors (1) or outdoors (0).
+pub const CSV_HEADER: &str = "x,y,z,nx,ny,nz,lux,df,storey,room,indoor";
 
 /// Reads sensors from a CSV file whose header names at least `x,y,z,nx,ny,nz` (any order, any
 /// case; other columns are ignored): model coordinates and the direction each sensor faces,
@@ -109,17 +111,24 @@ fn sensor(line: &str, columns: &[usize; 6]) -> Result<Sensor, String> {
 /// stop on it.
 ///
 /// # Panics
-/// If `lux` or `df` does not hold one value per sensor (a caller's bug).
-pub fn write_csv(path: &Path, sensors: &[Sensor], lux: &[f64], df: &[f64]) -> std::io::Result<()> {
+/// If `lux`, `df` or `zones` does not hold one value per sensor (a caller's bug).
+pub fn write_csv(
+    path: &Path,
+    sensors: &[Sensor],
+    lux: &[f64],
+    df: &[f64],
+    zones: &[Zone],
+) -> std::io::Result<()> {
     assert_eq!(sensors.len(), lux.len(), "one lux value per sensor");
     assert_eq!(sensors.len(), df.len(), "one daylight factor per sensor");
+    assert_eq!(sensors.len(), zones.len(), "one zone per sensor");
     let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
     writeln!(out, "{CSV_HEADER}")?;
-    for ((s, &l), &d) in sensors.iter().zip(lux).zip(df) {
+    for (((s, &l), &d), z) in sensors.iter().zip(lux).zip(df).zip(zones) {
         let (p, n) = (s.position, s.normal);
         writeln!(
             out,
-            "{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{}",
             p.x,
             p.y,
             p.z,
@@ -127,7 +136,10 @@ pub fn write_csv(path: &Path, sensors: &[Sensor], lux: &[f64], df: &[f64]) -> st
             n.y,
             n.z,
             finite(l),
-            finite(d)
+            finite(d),
+            z.storey,
+            z.room,
+            z.indoor as u8
         )?;
     }
     out.flush()
@@ -165,10 +177,29 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("grid.csv");
         let s = sensors();
-        write_csv(&path, &s, &[512.25, 1.0 / 7.0], &[2.5, 0.001]).unwrap();
+        let zones = [
+            Zone {
+                storey: 0,
+                room: 2,
+                indoor: true,
+            },
+            Zone {
+                storey: 3,
+                room: 0,
+                indoor: false,
+            },
+        ];
+        write_csv(&path, &s, &[512.25, 1.0 / 7.0], &[2.5, 0.001], &zones).unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
-        assert_eq!(text.lines().next(), Some("x,y,z,nx,ny,nz,lux,df"));
-        assert_eq!(text.lines().nth(1), Some("0.25,0.8,-4.75,0,1,0,512.25,2.5"));
+        assert_eq!(
+            text.lines().next(),
+            Some("x,y,z,nx,ny,nz,lux,df,storey,room,indoor")
+        );
+        assert_eq!(
+            text.lines().nth(1),
+            Some("0.25,0.8,-4.75,0,1,0,512.25,2.5,0,2,1")
+        );
+        assert!(text.lines().nth(2).unwrap().ends_with(",3,0,0"), "{text}");
         assert_eq!(read_points(&path).unwrap(), s);
     }
 
@@ -233,8 +264,20 @@ mod tests {
         }
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("grid.csv");
-        write_csv(&path, &sensors()[..1], &[f64::NAN], &[f64::INFINITY]).unwrap();
+        let zone = Zone {
+            storey: 0,
+            room: 1,
+            indoor: true,
+        };
+        write_csv(
+            &path,
+            &sensors()[..1],
+            &[f64::NAN],
+            &[f64::INFINITY],
+            &[zone],
+        )
+        .unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
-        assert!(text.ends_with(",0,0\n"), "{text}");
+        assert!(text.ends_with(",0,0,0,1,1\n"), "{text}");
     }
 }

@@ -12,9 +12,15 @@
 //!   directions, for whatever the work-plane rule does not fit (a sloping auditorium, vertical
 //!   sensors on a façade, a standard's own reference points).
 //!
-//! The results go to `grid.csv` ([`write_csv`]: `x,y,z,nx,ny,nz,lux,df`), `summary.json`
-//! ([`GridStats`]: mean, minimum, uniformity U0 = min/mean, …) and a false-colour plan
-//! ([`plan_image`]: one top view per storey, a legend in lux, north up).
+//! **Indoors, storeys and rooms** ([`GridSpec::place`], the rules in [`zones`]): a work-plane
+//! sensor with nothing over it (a garden, a terrace) is outdoors and left out unless
+//! `--grid-outdoor keep`; every sensor gets its storey, and the indoor sensors of a work plane
+//! their room (floor regions bounded by walls, doors included).
+//!
+//! The results go to `grid.csv` ([`write_csv`]: `x,y,z,nx,ny,nz,lux,df,storey,room,indoor`),
+//! `summary.json` ([`GridReport`]: mean, minimum, uniformity U0 = min/mean, …, of the grid and
+//! of each storey and room) and a false-colour plan ([`plan_image`]: one top view per storey,
+//! a legend in lux, north up).
 //!
 //! **Orientation.** Plans are laid out in the sky's compass ([`Compass`]: east = north × zenith),
 //! so the grid and the sky can never disagree about which way is north. Coordinates are model
@@ -29,11 +35,13 @@ mod plan;
 mod spacing;
 mod stats;
 pub mod work_plane;
+pub mod zones;
 
 pub use csv::{read_points, write_csv, CSV_HEADER};
 pub use plan::plan_image;
-pub use stats::{stats, GridStats};
+pub use stats::{stats, GridReport, GridStats, RoomStats, StoreyStats};
 pub use work_plane::{work_plane, MAX_COLUMNS, MIN_STOREY_CLEARANCE};
+pub use zones::{Outdoor, Zone};
 
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
@@ -48,6 +56,91 @@ pub struct Sensor {
     pub position: Vec3,
     /// Unit normal: the illuminance is that on a small plane facing this way.
     pub normal: Vec3,
+}
+
+/// The sensors a grid keeps and where each is ([`GridSpec::place`]).
+#[derive(Clone, Debug)]
+pub struct Placed {
+    pub sensors: Vec<Sensor>,
+    /// One per sensor.
+    pub zones: Vec<Zone>,
+    /// Each sensor's height along the zenith, metres.
+    pub heights: Vec<f64>,
+    /// The floor area one sensor stands for, m²: the lattice's cell, or for points from a file
+    /// the square of their typical spacing (0 if they have none).
+    pub cell_area: f64,
+    /// `--grid-outdoor`.
+    pub rule: Outdoor,
+    /// Sensors found outdoors, dropped or kept.
+    pub outdoor_points: u64,
+    /// Of those, how many were left out.
+    pub dropped_points: u64,
+    /// One line to warn of: every sensor of a work plane outdoors, so all kept.
+    pub warning: Option<String>,
+}
+
+impl Placed {
+    /// Classifies `sensors` (of a work plane when `plane` is given) and keeps those `rule`
+    /// keeps (see [`GridSpec::place`]).
+    fn new<I: Intersector>(
+        sensors: Vec<Sensor>,
+        plane: Option<zones::Plane>,
+        isect: &I,
+        compass: &Compass,
+        rule: Outdoor,
+    ) -> Placed {
+        let inside = zones::indoor(isect, compass, &sensors);
+        let n = sensors.len();
+        let outdoor_points = inside.iter().filter(|i| !**i).count();
+        let none_indoor = n > 0 && outdoor_points == n;
+        let dropping = plane.is_some() && rule == Outdoor::Drop;
+        let warning = (dropping && none_indoor).then(|| {
+            format!(
+                "grid: none of the {n} sensors has a roof or ceiling over it (a model without \
+                 one?), so all are kept and marked outdoor (--grid-outdoor keep keeps them \
+                 without this warning)"
+            )
+        });
+        let drop = dropping && !none_indoor;
+        let (sensors, inside): (Vec<Sensor>, Vec<bool>) = sensors
+            .into_iter()
+            .zip(inside)
+            .filter(|(_, i)| *i || !drop)
+            .unzip();
+        let storey = zones::storeys_of(compass, &sensors);
+        let room = match plane {
+            Some(p) => zones::rooms(isect, compass, &sensors, &inside, &storey, p),
+            None => vec![0; sensors.len()],
+        };
+        let local: Vec<glam::DVec3> = sensors
+            .iter()
+            .map(|s| compass.to_local(s.position.as_dvec3()))
+            .collect();
+        let cell_area = match plane {
+            Some(p) => p.spacing * p.spacing,
+            None => {
+                let plan: Vec<glam::DVec2> = local.iter().map(|p| p.truncate()).collect();
+                spacing::estimate(&plan, &storey).map_or(0.0, |s| s * s)
+            }
+        };
+        let zones = (0..sensors.len())
+            .map(|k| Zone {
+                storey: storey[k],
+                room: room[k],
+                indoor: inside[k],
+            })
+            .collect();
+        Placed {
+            dropped_points: (n - sensors.len()) as u64,
+            sensors,
+            zones,
+            heights: local.iter().map(|p| p.z).collect(),
+            cell_area,
+            rule,
+            outdoor_points: outdoor_points as u64,
+            warning,
+        }
+    }
 }
 
 /// Sensors whose heights differ by no more than this (metres) step by step are one storey:
@@ -78,6 +171,29 @@ impl GridSpec {
             }
             GridSpec::Points(path) => read_points(path),
         }
+    }
+
+    /// The sensors this spec asks for in `mesh` ([`GridSpec::sensors`]), each with its storey,
+    /// room and whether it is indoors ([`zones`]); outdoor sensors of a work plane are left out
+    /// by [`Outdoor::Drop`], unless none is indoors (a model without a roof: then all are kept,
+    /// with a [`Placed::warning`], rather than an empty grid). Points from a file are all kept,
+    /// whatever `rule` says: the user chose them.
+    pub fn place<I: Intersector>(
+        &self,
+        mesh: &Mesh,
+        isect: &I,
+        compass: &Compass,
+        rule: Outdoor,
+    ) -> Result<Placed, GridError> {
+        let sensors = self.sensors(mesh, isect, compass)?;
+        let plane = match self {
+            GridSpec::WorkPlane { height, spacing } => Some(zones::Plane {
+                height: *height as f64,
+                spacing: *spacing as f64,
+            }),
+            GridSpec::Points(_) => None,
+        };
+        Ok(Placed::new(sensors, plane, isect, compass, rule))
     }
 
     /// The cell size [`plan_image`] should draw: the lattice spacing, or 0 (estimate it) for

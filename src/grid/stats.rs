@@ -1,8 +1,11 @@
 //! The figures daylighting standards quote of a grid: mean, minimum and maximum illuminance,
 //! uniformity U0 = minimum / mean (as EN 12464-1 defines it), the median, and the mean daylight
-//! factor. They go to `summary.json`.
+//! factor, of the whole grid ([`GridStats`]) and of each storey and room ([`GridReport`]).
+//! They go to `summary.json`.
 
 use super::csv::finite;
+use super::{Outdoor, Placed};
+use std::collections::BTreeMap;
 
 /// A grid's figures. Every sensor weighs the same: on a work plane's lattice each stands for the
 /// same floor area, as the standards' grids assume.
@@ -58,6 +61,121 @@ pub fn stats(lux: &[f64], df: &[f64]) -> GridStats {
         },
         mean_df: df.iter().map(|&v| finite(v)).sum::<f64>() / n as f64,
         median_lux: (sorted[(n - 1) / 2] + sorted[n / 2]) / 2.0,
+    }
+}
+
+/// A storey's figures (the summary's `grid.storeys`).
+#[derive(serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+pub struct StoreyStats {
+    /// From 0 at the bottom.
+    pub storey: u32,
+    /// The height of its lowest sensors along the zenith, metres (as the plan labels it).
+    pub height: f64,
+    /// How many rooms were found on it.
+    pub rooms: u32,
+    /// The floor area its sensors stand for, m² (sensors × the lattice's cell).
+    pub area: f64,
+    #[serde(flatten)]
+    pub stats: GridStats,
+}
+
+/// A room's figures (the summary's `grid.rooms`).
+#[derive(serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+pub struct RoomStats {
+    pub storey: u32,
+    /// From 1 within its storey, as in `grid.csv`.
+    pub room: u32,
+    /// The floor area its sensors stand for, m².
+    pub area: f64,
+    #[serde(flatten)]
+    pub stats: GridStats,
+}
+
+/// The summary's `grid`: the whole grid's figures (the keys of [`GridStats`], at the top), the
+/// outdoor sensors found and what became of them, and the figures of each storey and room.
+#[derive(serde::Serialize, serde::Deserialize, Clone, Debug, PartialEq)]
+pub struct GridReport {
+    #[serde(flatten)]
+    pub all: GridStats,
+    /// The floor area the sensors stand for, m² (0 for points from a file without a spacing).
+    pub area: f64,
+    /// `--grid-outdoor`: `drop` or `keep`.
+    pub outdoor: Outdoor,
+    /// Sensors found outdoors (nothing over them), dropped or kept.
+    pub outdoor_points: u64,
+    /// Of those, how many were left out of the grid.
+    pub dropped_points: u64,
+    /// Bottom up.
+    pub storeys: Vec<StoreyStats>,
+    /// By storey, then room number.
+    pub rooms: Vec<RoomStats>,
+}
+
+impl GridReport {
+    /// The figures of the sensors `placed` (kept ones only) from their `lux` and `df`.
+    ///
+    /// # Panics
+    /// If `lux` or `df` does not hold one value per sensor (a caller's bug).
+    pub fn new(placed: &Placed, lux: &[f64], df: &[f64]) -> GridReport {
+        let n = placed.sensors.len();
+        assert!(lux.len() == n && df.len() == n, "one value per sensor");
+        let of = |k: &[usize]| {
+            let l: Vec<f64> = k.iter().map(|&k| lux[k]).collect();
+            let d: Vec<f64> = k.iter().map(|&k| df[k]).collect();
+            stats(&l, &d)
+        };
+        let area = |s: &GridStats| s.points as f64 * placed.cell_area;
+        // The sensors of each storey and of each room, in one pass.
+        let mut storey_of: BTreeMap<u32, (Vec<usize>, f64, u32)> = BTreeMap::new();
+        let mut room_of: BTreeMap<(u32, u32), Vec<usize>> = BTreeMap::new();
+        for (k, (z, &h)) in placed.zones.iter().zip(&placed.heights).enumerate() {
+            let s = storey_of.entry(z.storey).or_insert((Vec::new(), h, 0));
+            s.0.push(k);
+            s.1 = s.1.min(h);
+            if z.room > 0 {
+                room_of.entry((z.storey, z.room)).or_default().push(k);
+            }
+        }
+        for &(storey, _) in room_of.keys() {
+            if let Some(s) = storey_of.get_mut(&storey) {
+                s.2 += 1;
+            }
+        }
+        let storeys = storey_of
+            .into_iter()
+            .map(|(storey, (k, height, rooms))| {
+                let stats = of(&k);
+                StoreyStats {
+                    storey,
+                    height,
+                    rooms,
+                    area: area(&stats),
+                    stats,
+                }
+            })
+            .collect();
+        let rooms = room_of
+            .into_iter()
+            .map(|((storey, room), k)| {
+                let stats = of(&k);
+                RoomStats {
+                    storey,
+                    room,
+                    area: area(&stats),
+                    stats,
+                }
+            })
+            .collect();
+        let all = stats(lux, df);
+        GridReport {
+            area: area(&all),
+            all,
+            outdoor: placed.rule,
+            outdoor_points: placed.outdoor_points,
+            dropped_points: placed.dropped_points,
+            storeys,
+            rooms,
+        }
     }
 }
 

@@ -27,14 +27,15 @@
 //! grid**, whatever its height, as does anything lower than 2.3 m over a floor (a mezzanine, a
 //! duct, the flight of a stair above). Any up-facing surface with the clearance is a floor:
 //! stair treads and ramps get their sensors (as many storeys as the gap rule makes of them), and
-//! so does every surface open to the sky: a courtyard (which is wanted: Sponza's), a terrace, a
-//! flat roof, the ground modelled around a building. A column that runs exactly in the plane of
-//! a wall may see it as an obstacle and lose its sensor. A one-sided floor seen from below is no
-//! floor (its back does not exist); a floor modelled as two coincident opposite faces is merged
+//! so does every surface open to the sky: a courtyard (Sponza's), a terrace, a flat roof, the
+//! ground modelled around a building. A solve then leaves those out as outdoors unless asked
+//! to keep them ([`GridSpec::place`](super::GridSpec::place), `--grid-outdoor keep`). A
+//! column that runs exactly in the plane of a wall may see it as an obstacle and lose its
+//! sensor. A one-sided floor seen from below is no floor (its back does not exist); a floor modelled as two coincident opposite faces is merged
 //! into one two-sided surface when the model is loaded, and its up-facing side counts.
 //!
 //! Where that rule does not fit (furnished rooms read at desk height, sloping floors, sensors
-//! that are not horizontal, outdoor surfaces to be left out), give the points in a CSV file
+//! that are not horizontal), give the points in a CSV file
 //! (`--grid POINTS.csv`, [`read_points`](super::read_points)).
 //!
 //! # Cost

@@ -1,9 +1,10 @@
 //! The measure stage of a solve (docs/design.md §1): the sensor grid of `--grid`, measured on the solution, with its
-//! false-colour plan and statistics (written as `grid.csv` and `grid.png`).
+//! false-colour plan and statistics (written as `grid.csv` and `grid.png`): outdoor sensors
+//! left out unless `--grid-outdoor keep`, the figures of each storey and room logged.
 
 use super::stages::{Clock, Solved};
 use super::SolveJob;
-use crate::grid::{self, GridSpec, GridStats};
+use crate::grid::{self, GridReport, GridSpec, GridStats};
 use crate::intersect::select::AnyIntersector;
 use crate::light::LightAt;
 use crate::sky::{Compass, EFFICACY};
@@ -45,16 +46,77 @@ pub fn measure_grid(
     let g = measure(job, spec, solved, isect, &frame).map_err(|e| Error::Invalid(e.to_string()))?;
     let (seconds, cpu_seconds) = (clock.seconds(), clock.cpu_seconds());
     let plan = grid::plan_image(&g.sensors, &g.lux, &frame, spec.spacing_hint(), PLAN_WIDTH);
-    log(&format!(
-        "grid: {} sensors, mean {:.0} lux, min {:.0} lux, uniformity {:.2}, mean daylight factor {:.2} %",
-        g.stats.points, g.stats.mean_lux, g.stats.min_lux, g.stats.uniformity, g.stats.mean_df
-    ));
+    for line in lines(&g.stats) {
+        log(&line);
+    }
+    if let Some(w) = &g.warning {
+        log(&format!("warning: {w}"));
+    }
     Ok(Some(Measured {
         grid: g,
         plan,
         seconds,
         cpu_seconds,
     }))
+}
+
+/// What the log says of a grid: its figures, the outdoor sensors, and one short line per
+/// storey and per room when there are several.
+fn lines(r: &GridReport) -> Vec<String> {
+    let figures = |s: &GridStats| {
+        format!(
+            "mean {:.0} lux, min {:.0} lux, uniformity {:.2}, mean daylight factor {:.2} %",
+            s.mean_lux, s.min_lux, s.uniformity, s.mean_df
+        )
+    };
+    let mut out = vec![format!(
+        "grid: {} sensors, {}",
+        r.all.points,
+        figures(&r.all)
+    )];
+    if r.outdoor_points > 0 {
+        out.push(if r.dropped_points > 0 {
+            format!(
+                "grid: {} outdoor sensors left out (nothing over them; --grid-outdoor keep keeps them)",
+                r.dropped_points
+            )
+        } else {
+            format!(
+                "grid: {} outdoor sensors kept (indoor 0 in grid.csv)",
+                r.outdoor_points
+            )
+        });
+    }
+    if r.storeys.len() > 1 {
+        for s in &r.storeys {
+            out.push(format!(
+                "  storey {} (+{:.1} m): {} sensors, {:.1} m², {} room{}, {}",
+                s.storey,
+                s.height,
+                s.stats.points,
+                s.area,
+                s.rooms,
+                if s.rooms == 1 { "" } else { "s" },
+                figures(&s.stats)
+            ));
+        }
+    }
+    if r.rooms.len() > 1 {
+        for m in &r.rooms {
+            out.push(format!(
+                "  room {}.{}: {} sensors, {:.1} m², mean {:.0} lux, min {:.0} lux, U0 {:.2}, DF {:.2} %",
+                m.storey,
+                m.room,
+                m.stats.points,
+                m.area,
+                m.stats.mean_lux,
+                m.stats.min_lux,
+                m.stats.uniformity,
+                m.stats.mean_df
+            ));
+        }
+    }
+    out
 }
 
 /// The model's orientation: the sky's zenith and north, else the job's (checked), else the
@@ -72,15 +134,21 @@ pub fn frame_of(job: &SolveJob) -> Compass {
     })
 }
 
-/// A grid's sensors and what they measured.
+/// A grid's sensors, where each is, and what they measured.
 pub struct GridResult {
     pub sensors: Vec<grid::Sensor>,
+    /// One per sensor: storey, room, indoors (`grid.csv`'s last columns).
+    pub zones: Vec<grid::Zone>,
     pub lux: Vec<f64>,
     pub df: Vec<f64>,
-    pub stats: GridStats,
+    /// The summary's `grid`.
+    pub stats: GridReport,
+    /// One line to warn of ([`grid::Placed::warning`]).
+    pub warning: Option<String>,
 }
 
-/// Lux at each sensor of `spec` from the solution: the gather at each point
+/// Lux at each sensor `spec` keeps ([`GridSpec::place`], `--grid-outdoor`) from the solution:
+/// the gather at each point
 /// ([`LightAt::sensor_irradiance`], `--grid-rays` each, the solve's seed),
 /// luminance-weighted, × 179 lm/W; the daylight factor over `df_base` (0 without a sky).
 fn measure(
@@ -93,8 +161,12 @@ fn measure(
     let (mesh, materials) = (&solved.model.mesh, &solved.model.scene.materials);
     let (b, sky) = (&solved.sol.b, solved.sky.as_ref());
     let (rays, seed) = (job.grid_rays, job.settings.solve.seed);
-    let sensors = spec.sensors(mesh, isect, frame)?;
-    let at: Vec<_> = sensors.iter().map(|s| (s.position, s.normal)).collect();
+    let placed = spec.place(mesh, isect, frame, job.grid_outdoor)?;
+    let at: Vec<_> = placed
+        .sensors
+        .iter()
+        .map(|s| (s.position, s.normal))
+        .collect();
     let h = LightAt::new(mesh, materials, isect, b, sky, None).sensor_irradiance(&at, rays, seed);
     let luma = crate::export::patches::LUMA;
     let lux: Vec<f64> = h
@@ -110,11 +182,13 @@ fn measure(
         .iter()
         .map(|l| base.filter(|b| *b > 0.0).map_or(0.0, |b| 100.0 * l / b))
         .collect();
-    let stats = grid::stats(&lux, &df);
+    let stats = GridReport::new(&placed, &lux, &df);
     Ok(GridResult {
-        sensors,
+        sensors: placed.sensors,
+        zones: placed.zones,
         lux,
         df,
         stats,
+        warning: placed.warning,
     })
 }

@@ -122,6 +122,8 @@ pub struct SolveJob {
     pub grid: Option<crate::grid::GridSpec>,
     /// Rays each sensor gathers (`--grid-rays`).
     pub grid_rays: usize,
+    /// What becomes of the work plane's outdoor sensors (`--grid-outdoor`).
+    pub grid_outdoor: crate::grid::Outdoor,
     /// The model's up and north (`--zenith`, `--north`, the default north following the
     /// zenith: [`crate::sky::Compass::default_north`]): the sky's compass, and the work
     /// plane's up when a grid is asked for without a sky.
@@ -150,6 +152,7 @@ impl SolveJob {
             interrupt: None,
             grid: None,
             grid_rays: daylight::DEFAULT_GRID_RAYS,
+            grid_outdoor: crate::grid::Outdoor::Drop,
             zenith: crate::sky::DEFAULT_ZENITH,
             north: crate::sky::DEFAULT_NORTH,
             shading: Default::default(),

@@ -120,7 +120,7 @@ pub fn write(
     if let Some(g) = &results.measured {
         let grid_csv = job.out.join("grid.csv");
         let (s, lux, df) = (&g.grid.sensors, &g.grid.lux, &g.grid.df);
-        crate::grid::write_csv(&grid_csv, s, lux, df).map_err(|source| {
+        crate::grid::write_csv(&grid_csv, s, lux, df, &g.grid.zones).map_err(|source| {
             crate::export::WriteError {
                 path: grid_csv.clone(),
                 source,
@@ -156,6 +156,12 @@ pub fn write(
         .iter()
         .cloned()
         .chain(results.warnings)
+        .chain(
+            results
+                .measured
+                .as_ref()
+                .and_then(|g| g.grid.warning.clone()),
+        )
         .collect();
     let mut summary = summary(job, solved, timings, warnings, outputs);
     summary.grid = results.measured.map(|g| g.grid.stats);

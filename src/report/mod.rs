@@ -389,9 +389,10 @@ pub struct Summary {
     /// The sky (docs/design.md §9), when the solve had one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sky: Option<sky::SkyReport>,
-    /// The sensor grid's statistics (`--grid`).
+    /// The sensor grid's statistics (`--grid`): the whole grid's, the outdoor sensors found,
+    /// and each storey's and room's.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub grid: Option<crate::grid::GridStats>,
+    pub grid: Option<crate::grid::GridReport>,
 }
 
 impl Summary {

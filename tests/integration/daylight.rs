@@ -385,7 +385,11 @@ fn a_daylit_solve_writes_the_grid_and_the_sky() {
     assert_eq!(code, 0, "{err}");
     let csv = std::fs::read_to_string(out.join("grid.csv")).unwrap();
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("x,y,z,nx,ny,nz,lux,df"));
+    // The columns of old first, in their order; where each sensor is after them.
+    assert_eq!(
+        lines.next(),
+        Some("x,y,z,nx,ny,nz,lux,df,storey,room,indoor")
+    );
     let lux: Vec<f64> = lines
         .map(|l| l.split(',').nth(6).unwrap().parse().unwrap())
         .collect();

@@ -23,6 +23,7 @@ use std::collections::BTreeSet;
 /// Bad settings, each with the commands that take its flags besides `solve` (checked against
 /// clap's list: a command that gains the flag must be added here, and refuse it alike).
 const BAD: &[(&[&str], &[&str])] = &[
+    (&["--grid-outdoor", "maybe"], &[]),
     (
         &["--tolerance", "5"],
         &[
@@ -405,6 +406,10 @@ const NOT_SHAPING: &[(&str, &str)] = &[
         "sensors measured on the solution (the summary's `grid`)",
     ),
     ("grid-rays", "the sensors' rays (the summary's `grid`)"),
+    (
+        "grid-outdoor",
+        "which sensors are measured (the summary's `grid`)",
+    ),
     ("view", "the picture's camera"),
     ("eye", "the picture's camera"),
     ("target", "the picture's camera"),

@@ -52,14 +52,20 @@ pub struct SkyArgs {
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub north: Option<Vec3>,
     /// Illuminance sensors: HEIGHT,SPACING in metres (a work plane above each floor: an
-    /// upward surface with at least 2.3 m clear above it), or a CSV file of points with
-    /// columns x,y,z,nx,ny,nz. Writes grid.csv (x,y,z,nx,ny,nz,lux,df), the plan grid.png,
-    /// and the grid's mean/min/uniformity in summary.json.
+    /// upward surface with at least 2.3 m clear above it; indoors only, see --grid-outdoor),
+    /// or a CSV file of points with columns x,y,z,nx,ny,nz. Writes grid.csv
+    /// (x,y,z,nx,ny,nz,lux,df,storey,room,indoor), the plan grid.png, and the grid's
+    /// mean/min/uniformity, per storey and per room, in summary.json.
     #[arg(long, value_name = "HEIGHT,SPACING|POINTS.csv")]
     pub grid: Option<radiosity::grid::GridSpec>,
     /// Rays each grid sensor gathers.
     #[arg(long, default_value_t = radiosity::pipeline::daylight::DEFAULT_GRID_RAYS, value_name = "N")]
     pub grid_rays: usize,
+    /// The work plane's outdoor sensors (nothing over them: a garden, a terrace): drop leaves
+    /// them out (if a model has no roof at all, all are kept, with a warning); keep keeps
+    /// them, marked indoor 0 in grid.csv. Points from a file are always kept.
+    #[arg(long, value_enum, default_value_t = radiosity::grid::Outdoor::Drop, value_name = "drop|keep")]
+    pub grid_outdoor: radiosity::grid::Outdoor,
 }
 
 impl SkyArgs {

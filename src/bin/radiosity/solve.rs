@@ -155,6 +155,7 @@ impl SolveArgs {
             interrupt: None,
             grid: self.sky.grid.clone(),
             grid_rays: self.sky.grid_rays,
+            grid_outdoor: self.sky.grid_outdoor,
             zenith,
             north,
             shading: self
