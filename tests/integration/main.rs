@@ -28,3 +28,4 @@ mod solve_analytic;
 mod solve_methods;
 mod stiff;
 mod view;
+mod views;
