@@ -17,9 +17,11 @@
 //! [`PROBE_COLS`] × [`PROBE_ROWS`] pixel centres sees the *outside* of the model when the first
 //! face it shows (the first it meets from the front, as the picture culls backs) is met before
 //! any back face — nothing is seen through a wall — and the ray, going on past that face, next
-//! meets the back of a face: what it shows is the outer skin of something closed. When more
-//! than [`OUTSIDE_SHARE`] of the rays that show anything see the outside, the model is taken
-//! for a building seen from outside, and the default view becomes a plan of its top storey:
+//! meets the back of a face: what it shows is the outer skin of something closed. A ray that
+//! shows open ground (a face looking up, met directly, nothing behind it: a site, a garden, a
+//! Cornell box's floor) is not counted, so a garden around a house does not outweigh it. When
+//! more than [`OUTSIDE_SHARE`] of the counted rays see the outside, the model is taken for a
+//! building seen from outside, and the default view becomes a plan of its top storey:
 //!
 //! - vertical rays down through a [`PLAN_RAYS`] × [`PLAN_RAYS`] lattice over the bounding box
 //!   find, on each, the first *indoor floor* from the top: a face looking up (its normal within
@@ -32,7 +34,9 @@
 //!   above the cut are clipped (the camera's near plane, as `--near` clips by hand, and a
 //!   Radiance view's `-vo` writes), and the top storey is seen from above, its walls cut;
 //! - the camera looks straight down the zenith, north up the picture and east to the right,
-//!   fitted to the bounding box below the cut (perspective, 40° as the fitted view).
+//!   fitted to the part of the bounding box below the cut and over the lattice cells whose rays
+//!   found an indoor floor (so a garden around the house is left out), perspective, 40° as the
+//!   fitted view.
 //!
 //! A model with no indoor floor under any ray keeps the fitted view. Open boxes seen from
 //! their open side (a Cornell box) and rooms seen through their near wall keep it too: their
@@ -124,25 +128,67 @@ pub fn fitted(lo: Vec3, hi: Vec3, aspect: f32, zenith: Vec3) -> Camera {
 /// plan of a building seen from outside (see the [module docs](self)).
 pub fn default_camera<I: Intersector>(m: &ModelView<'_, I>, aspect: f32) -> (Camera, DefaultView) {
     let cam = fitted(m.lo, m.hi, aspect, m.zenith);
-    let Some((mesh, isect)) = m.probe else {
+    let Some(outside) = outside_share(m, aspect) else {
         return (cam, DefaultView::Fitted);
     };
-    let probe = Probe::new(mesh, isect, m.lo, m.hi);
-    let outside = outside_share(&probe, &cam);
     if outside <= OUTSIDE_SHARE {
         return (cam, DefaultView::Fitted);
     }
-    match top_storey(&probe, m) {
-        Some((floor, cut)) => (
-            plan(m, aspect, cut),
+    let Some((mesh, isect)) = m.probe else {
+        return (cam, DefaultView::Fitted);
+    };
+    match top_storey(&Probe::new(mesh, isect, m.lo, m.hi), m) {
+        Some(storey) => (
+            plan(m, aspect, &storey),
             DefaultView::Plan {
-                floor,
-                cut,
+                floor: storey.floor,
+                cut: storey.cut,
                 outside,
             },
         ),
         None => (cam, DefaultView::Fitted),
     }
+}
+
+/// The share of the fitted view's counted probe rays (those that show anything but open
+/// ground) that see the model's outside ([module docs](self)); `None` without a probe, 0 when
+/// no ray counts.
+pub fn outside_share<I: Intersector>(m: &ModelView<'_, I>, aspect: f32) -> Option<f64> {
+    let (mesh, isect) = m.probe?;
+    let probe = Probe::new(mesh, isect, m.lo, m.hi);
+    let cam = fitted(m.lo, m.hi, aspect, m.zenith);
+    let (up, _) = orientation(m.zenith);
+    let (mut counted, mut outside) = (0usize, 0usize);
+    for row in 0..PROBE_ROWS {
+        for col in 0..PROBE_COLS {
+            let u = (col as f32 + 0.5) / PROBE_COLS as f32;
+            let v = (row as f32 + 0.5) / PROBE_ROWS as f32;
+            let (org, dir) = cam.ray(u, v);
+            match probe.seen(org, dir, up) {
+                None | Some(Seen::Ground) => {}
+                Some(seen) => {
+                    counted += 1;
+                    outside += usize::from(seen == Seen::Outside);
+                }
+            }
+        }
+    }
+    Some(if counted == 0 {
+        0.0
+    } else {
+        outside as f64 / counted as f64
+    })
+}
+
+/// What a probe ray through the fitted view shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Seen {
+    /// The outer skin of something closed: met directly, and past it the ray meets a back.
+    Outside,
+    /// Open ground: a face looking up, met directly, with nothing behind it (not counted).
+    Ground,
+    /// Anything else: seen through a wall's back, or an open box's inside.
+    Other,
 }
 
 /// The patches and an intersector, with the step past a face met.
@@ -184,19 +230,29 @@ impl<'a, I: Intersector> Probe<'a, I> {
             )
     }
 
-    /// What the ray shows: `None` if nothing, else whether it is the model's outside (see the
-    /// [module docs](self)).
-    fn sees_outside(&self, org: Vec3, dir: Vec3) -> Option<bool> {
+    /// What the ray shows: `None` if nothing, else what (see the [module docs](self)).
+    fn seen(&self, org: Vec3, dir: Vec3, up: Vec3) -> Option<Seen> {
         let mut t = 0.0;
         let mut through_a_back = false;
         for _ in 0..MAX_HITS {
             let h = self.next(org, dir, t)?;
             if self.shows(&h) {
                 if through_a_back {
-                    return Some(false);
+                    return Some(Seen::Other);
                 }
-                let behind = self.next(org, dir, h.t + self.step);
-                return Some(behind.is_some_and(|b| b.back));
+                return Some(match self.next(org, dir, h.t + self.step) {
+                    Some(b) if b.back => Seen::Outside,
+                    Some(_) => Seen::Other,
+                    None => {
+                        let n = self.mesh.patches[h.patch as usize].normal;
+                        let n = if h.back { -n } else { n };
+                        if n.dot(up) >= FLOOR_COS {
+                            Seen::Ground
+                        } else {
+                            Seen::Other
+                        }
+                    }
+                });
             }
             through_a_back = true;
             t = h.t + self.step;
@@ -205,31 +261,20 @@ impl<'a, I: Intersector> Probe<'a, I> {
     }
 }
 
-/// The share of the fitted view's probe rays that show anything which see the model's
-/// outside (0 when none shows anything).
-fn outside_share<I: Intersector>(probe: &Probe<'_, I>, cam: &Camera) -> f64 {
-    let (mut shown, mut outside) = (0usize, 0usize);
-    for row in 0..PROBE_ROWS {
-        for col in 0..PROBE_COLS {
-            let u = (col as f32 + 0.5) / PROBE_COLS as f32;
-            let v = (row as f32 + 0.5) / PROBE_ROWS as f32;
-            let (org, dir) = cam.ray(u, v);
-            if let Some(out) = probe.sees_outside(org, dir) {
-                shown += 1;
-                outside += usize::from(out);
-            }
-        }
-    }
-    if shown == 0 {
-        0.0
-    } else {
-        outside as f64 / shown as f64
-    }
+/// The top storey a plan shows ([`top_storey`]).
+struct Storey {
+    /// Its floor's height and the cut's, along the zenith.
+    floor: f32,
+    cut: f32,
+    /// The part of the bounding box over its floors, in fractions of the box's half-extents
+    /// east and north of its centre (−1 to 1): the lattice cells whose rays found one.
+    east: (f32, f32),
+    north: (f32, f32),
 }
 
-/// The top storey's floor height and the plan's cut (heights along the zenith), from vertical
-/// rays down through the bounding box; `None` when no ray finds an indoor floor.
-fn top_storey<I: Intersector>(probe: &Probe<'_, I>, m: &ModelView<'_, I>) -> Option<(f32, f32)> {
+/// The top storey (see the [module docs](self)), from vertical rays down through the
+/// bounding box; `None` when no ray finds an indoor floor.
+fn top_storey<I: Intersector>(probe: &Probe<'_, I>, m: &ModelView<'_, I>) -> Option<Storey> {
     let (up, north) = orientation(m.zenith);
     let east = north.cross(up);
     let centre = 0.5 * (m.lo + m.hi);
@@ -239,21 +284,30 @@ fn top_storey<I: Intersector>(probe: &Probe<'_, I>, m: &ModelView<'_, I>) -> Opt
     // Start above the top, so the first face met is the highest.
     let above = centre + (hu + 0.01 * (hu + he + hn) + probe.step) * up;
     let (mut floors, mut rooms) = (Vec::new(), Vec::new());
+    let cell = 1.0 / PLAN_RAYS as f32;
+    let (mut ea, mut na) = ((1.0f32, -1.0f32), (1.0f32, -1.0f32));
     for i in 0..PLAN_RAYS {
         for j in 0..PLAN_RAYS {
-            let a = 2.0 * (i as f32 + 0.5) / PLAN_RAYS as f32 - 1.0;
-            let b = 2.0 * (j as f32 + 0.5) / PLAN_RAYS as f32 - 1.0;
+            let a = 2.0 * (i as f32 + 0.5) * cell - 1.0;
+            let b = 2.0 * (j as f32 + 0.5) * cell - 1.0;
             let org = above + a * he * east + b * hn * north;
-            if let Some((floor, ceiling)) = indoor_floor(probe, org, up, MIN_ROOM_SHARE * 2.0 * hu)
-            {
+            let min_room = MIN_ROOM_SHARE * 2.0 * hu;
+            if let Some((floor, ceiling)) = indoor_floor(probe, org, up, min_room) {
                 floors.push(floor);
                 rooms.push(ceiling - floor);
+                ea = (ea.0.min(a - cell), ea.1.max(a + cell));
+                na = (na.0.min(b - cell), na.1.max(b + cell));
             }
         }
     }
     let floor = median(&mut floors)?;
     let room = median(&mut rooms)?;
-    Some((floor, floor + 0.5 * room))
+    Some(Storey {
+        floor,
+        cut: floor + 0.5 * room,
+        east: ea,
+        north: na,
+    })
 }
 
 /// Along the ray down from `org`: the height (along `up`) of the first face looking up that
@@ -299,22 +353,29 @@ fn median(v: &mut Vec<f32>) -> Option<f32> {
     Some(v[(v.len() - 1) / 2])
 }
 
-/// The plan camera: straight down the zenith, north up the picture, fitted to the bounding box
-/// below `cut`, its near plane at the cut.
-fn plan<I>(m: &ModelView<'_, I>, aspect: f32, cut: f32) -> Camera {
+/// The plan camera: straight down the zenith, north up the picture, fitted to the part of the
+/// bounding box over the storey's floors and below its cut, its near plane at the cut.
+fn plan<I>(m: &ModelView<'_, I>, aspect: f32, storey: &Storey) -> Camera {
     let (up, north) = orientation(m.zenith);
+    let east = north.cross(up);
     let (lo, hi) = (m.lo, m.hi);
     let frame = Camera::perspective(Vec3::ZERO, -up, north, 40.0, 1.0).frame();
     let h = 0.5 * (hi - lo);
-    let centre = 0.5 * (lo + hi);
     let mut half = frame.half_extent(h);
-    // The box's extent along the zenith (the frame's backward axis), cut at `cut`.
+    // Across: the storey's part of the box (the frame's right is east, its up north).
+    let (he, hn) = (east.abs().dot(h), north.abs().dot(h));
+    let (e, n) = (storey.east, storey.north);
+    let mut centre =
+        0.5 * (lo + hi) + (0.5 * (e.0 + e.1) * he) * east + (0.5 * (n.0 + n.1) * hn) * north;
+    half.x *= 0.5 * (e.1 - e.0);
+    half.y *= 0.5 * (n.1 - n.0);
+    // Along the zenith (the frame's backward axis): from the bottom to the cut.
     let mid = centre.dot(up);
-    let (bottom, top) = (mid - half.z, (mid + half.z).min(cut));
+    let (bottom, top) = (mid - half.z, (mid + half.z).min(storey.cut));
     half.z = 0.5 * (top - bottom).max(0.0);
-    let centre = centre + (0.5 * (bottom + top) - mid) * up;
+    centre += (0.5 * (bottom + top) - mid) * up;
     let mut cam = Camera::fit_frame(centre, half, h.length(), &frame, aspect);
-    cam.near = (cam.eye.dot(up) - cut).max(0.0);
+    cam.near = (cam.eye.dot(up) - storey.cut).max(0.0);
     cam
 }
 
