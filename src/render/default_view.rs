@@ -9,7 +9,8 @@
 //! ([`Camera::fit_along`]). For a Y-up model this is the camera every version before took;
 //! a Z-up model now gets the same view of itself rather than its roof from above. Back faces
 //! are culled, so the rooms of a model made of one-sided faces looking into the rooms (the
-//! scenes of `scenes/`, a Cornell box) are seen through the near wall.
+//! scenes of `scenes/`) are seen through the near wall, and an open box (a Cornell box)
+//! through its open side.
 //!
 //! **A building's plan.** A model whose walls and roof are closed solids (a CAD or IFC export:
 //! every wall, slab and roof a box, its faces looking out) shows nothing but its outside to
@@ -40,7 +41,9 @@
 //!
 //! A model with no indoor floor under any ray keeps the fitted view. Open boxes seen from
 //! their open side (a Cornell box) and rooms seen through their near wall keep it too: their
-//! rays see the inside. The rule reads the geometry only along fixed rays, so it is
+//! rays see the inside (measured: 17 % of the Cornell box's fitted view sees an outside, its
+//! two blocks; 0 % of every other scene's; 96–100 % of a two-storey house of solids, Y or Z
+//! up, with or without a garden: `tests/integration/views.rs`). The rule reads the geometry only along fixed rays, so it is
 //! deterministic, and a model rotated from Y up to Z up (with `--zenith` saying so) gets the
 //! same view of itself.
 
