@@ -228,7 +228,16 @@ fn y_up_and_z_up_houses_give_the_same_picture() {
 /// The default camera of a scene with zenith `up`, the view taken, and the share of the
 /// fitted view that sees the outside.
 fn default_of(scene: &Scene, up: Vec3) -> (Camera, DefaultView, f64) {
-    let m = radiosity::mesh::build(scene, &Default::default());
+    default_of_sided(scene, up, false)
+}
+
+/// [`default_of`], the mesh two-sided when `two_sided`.
+fn default_of_sided(scene: &Scene, up: Vec3, two_sided: bool) -> (Camera, DefaultView, f64) {
+    let opts = radiosity::mesh::MeshOptions {
+        patch_size: None,
+        two_sided,
+    };
+    let m = radiosity::mesh::build(scene, &opts);
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
     let (lo, hi) = scene.bounds();
     let model = ModelView {
@@ -340,6 +349,19 @@ fn a_house_in_a_garden_gets_the_plan_of_its_top_storey_filling_the_picture() {
         u > 0.6 && v > 0.6,
         "the floor spans {u} × {v} of the picture"
     );
+}
+
+#[test]
+fn a_two_sided_closed_room_gets_its_plan_not_its_near_walls_outside() {
+    // Two-sided, the office's near wall shows its back patch to the fitted camera: the
+    // outside, unlit.
+    let (office, _) = project_scene("office.obj");
+    let (_, view, outside) = default_of_sided(&office, Vec3::Y, true);
+    let DefaultView::Plan { floor, cut, .. } = view else {
+        panic!("{view:?}, outside {outside}")
+    };
+    // The floor at 0, the ceiling at 2.7.
+    assert!(floor.abs() < 1e-3 && (cut - 1.35).abs() < 1e-3, "{view:?}");
 }
 
 /// A small closed box that glows, as an OBJ in `dir`.
