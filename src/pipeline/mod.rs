@@ -201,11 +201,8 @@ pub fn run_solve_with(
 ) -> Result<Summary, Error> {
     job.check()?;
     let t0 = Instant::now();
-    if let Some(save) = &job.save {
-        outputs::check_save_path(save)?;
-    }
-    // Fail on an unwritable folder before spending any time.
-    let made = export::prepare_dir(&job.out)?;
+    // Fail on an unwritable folder or a bad --save before spending any time.
+    let made = outputs::prepare_out(job)?;
     // On failure leave nothing behind: not the files written so far, not the new folders.
     let mut written = Vec::new();
     let result = solve_into(job, progress, &mut log, t0, &mut written);

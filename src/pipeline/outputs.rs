@@ -11,7 +11,7 @@ use super::stages::Solved;
 use super::SolveJob;
 use crate::elements::Elements;
 use crate::export::solution::{self, SavedMaterial, SolutionMeta};
-use crate::export::{patches, write_atomic};
+use crate::export::{self, patches, write_atomic};
 use crate::intersect::Intersector;
 use crate::model::Model;
 use crate::report::{self, EnergyReport, Summary, Timings};
@@ -262,7 +262,23 @@ fn write_png(path: &std::path::Path, img: &image::RgbImage) -> Result<(), Error>
     Ok(())
 }
 
-/// Refuses a `--save` path that cannot be written, before any work is spent.
+/// Makes the output folder (`--out`, and the folders above it that are missing), then checks
+/// `--save` ([`check_save_path`]), so a solution saved into the folder being made
+/// (`--out DIR --save DIR/s.rad`) is taken. On a refused `--save` the folders just made are
+/// removed again. Returns the folders made (for [`export::remove_made_dirs`] on failure).
+pub fn prepare_out(job: &SolveJob) -> Result<Vec<PathBuf>, Error> {
+    let made = export::prepare_dir(&job.out)?;
+    if let Some(save) = &job.save {
+        if let Err(e) = check_save_path(save) {
+            export::remove_made_dirs(&made);
+            return Err(e);
+        }
+    }
+    Ok(made)
+}
+
+/// Refuses a `--save` path that cannot be written, before any work is spent (after the
+/// output folder is made: [`prepare_out`]).
 pub fn check_save_path(path: &std::path::Path) -> Result<(), Error> {
     if path.is_dir() {
         return Err(Error::Invalid(format!(

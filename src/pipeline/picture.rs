@@ -7,6 +7,7 @@ use super::stages::Solved;
 use super::SolveJob;
 use crate::intersect::select::AnyIntersector;
 use crate::mesh::Mesh;
+use crate::render::default_view::ModelView;
 use crate::render::{self, Camera, RenderOptions, Shading, ShadingSettings};
 use crate::Error;
 
@@ -18,8 +19,7 @@ pub fn picture(
     refined: &Refined,
     log: &mut impl FnMut(&str),
 ) -> Result<image::RgbImage, Error> {
-    let (lo, hi) = solved.model.scene.bounds();
-    let cam = job.view.camera_for(lo, hi);
+    let cam = camera(job, solved, isect, log);
     let elements = &refined.elements;
     let img = match job.shading.shading {
         Shading::Gouraud => {
@@ -38,6 +38,44 @@ pub fn picture(
         }
     };
     Ok(img)
+}
+
+/// The camera of `render.png`: the job's, or the default view of the model
+/// ([`render::default_view`]: fitted with the zenith up, or a building's plan), its rays
+/// probing through `isect` or, for a method that cast none, an intersector built for them.
+fn camera(
+    job: &SolveJob,
+    solved: &Solved,
+    isect: Option<&AnyIntersector>,
+    log: &mut impl FnMut(&str),
+) -> Camera {
+    let (lo, hi) = solved.model.scene.bounds();
+    let zenith = job
+        .settings
+        .solve
+        .sky
+        .as_ref()
+        .map_or(job.zenith, |s| s.zenith);
+    let built = match isect {
+        None if job.view.camera.is_default() => solved
+            .model
+            .intersector(job.settings.intersector)
+            .ok()
+            .map(|(i, _)| i),
+        _ => None,
+    };
+    let probe = isect.or(built.as_ref()).map(|i| (&solved.model.mesh, i));
+    let model = ModelView {
+        lo,
+        hi,
+        zenith,
+        probe,
+    };
+    let (cam, view) = job.view.camera_of(&model);
+    if let Some(line) = view.and_then(|v| v.describe()) {
+        log(&format!("render.png: {line}"));
+    }
+    cam
 }
 
 /// The final-gather picture of a solve (`--shading gather`) with the solve's sky and seed.

@@ -131,16 +131,42 @@ impl Camera {
     }
 
     /// Fitted to the scene: looks along -z from the +z side (y up), fov 40°, distance so the whole
-    /// bounding box fits in view with a small margin, aimed at the box centre.
+    /// bounding box fits in view with a small margin, aimed at the box centre
+    /// ([`Camera::fit_along`] along −z with y up).
     ///
     /// A non-finite or inverted box (such as the bounds of an empty mesh) is replaced by the unit
     /// cube around the origin; a non-positive or non-finite `aspect` (width / height) by 1.
     pub fn fit(lo: Vec3, hi: Vec3, aspect: f32) -> Camera {
+        Camera::fit_along(lo, hi, aspect, Vec3::NEG_Z, Vec3::Y)
+    }
+
+    /// Fitted to the scene seen along `fwd` with `up` up the picture: fov 40°, distance so the
+    /// whole bounding box fits in view with a small margin, aimed at the box centre. The box is
+    /// measured along the axes of the camera's frame (its extent along each, which is exact for
+    /// an axis-aligned frame), so any direction fits. A degenerate `fwd` or `up` falls back as
+    /// [`Camera::frame`] does; the box and `aspect` are sanitised as in [`Camera::fit`].
+    pub fn fit_along(lo: Vec3, hi: Vec3, aspect: f32, fwd: Vec3, up: Vec3) -> Camera {
         let (lo, hi) = if lo.is_finite() && hi.is_finite() && lo.cmple(hi).all() {
             (lo, hi)
         } else {
             (Vec3::splat(-0.5), Vec3::splat(0.5))
         };
+        let frame = Camera::perspective(Vec3::ZERO, fwd, up, 40.0, 1.0).frame();
+        let h = 0.5 * (hi - lo);
+        let half = frame.half_extent(h);
+        Camera::fit_frame(0.5 * (lo + hi), half, h.length(), &frame, aspect)
+    }
+
+    /// Fitted to a box of centre `centre` and half-extents `half` along the frame's right, up
+    /// and backward axes (see [`Camera::fit_along`]); `extent` is the scene's size that keeps
+    /// the box's near face in front of the eye even when the box is flat.
+    pub(crate) fn fit_frame(
+        centre: Vec3,
+        half: Vec3,
+        extent: f32,
+        frame: &CameraFrame,
+        aspect: f32,
+    ) -> Camera {
         let aspect = if aspect.is_finite() && aspect > 0.0 {
             aspect
         } else {
@@ -151,10 +177,10 @@ impl Camera {
         let Vec2 { x: tan_x, y: tan_y } = projection.half_extent();
         // Corners end up at most 1/MARGIN of the way from the image centre to its edge.
         const MARGIN: f32 = 1.1;
-        let centre = 0.5 * (lo + hi);
-        let h = 0.5 * (hi - lo);
-        // With the eye at centre + d·z, a corner at offset (x, y, z) lies at depth d − z and is
-        // in view when |x| ≤ (d − z)·tan_x / MARGIN (same for y): solve each for d.
+        let h = half;
+        // With the eye at centre + d·back, a corner at offset (x, y, z) in the frame lies at
+        // depth d − z and is in view when |x| ≤ (d − z)·tan_x / MARGIN (same for y): solve each
+        // for d.
         let mut d: f32 = 0.0;
         for z in [-h.z, h.z] {
             d = d
@@ -162,18 +188,12 @@ impl Camera {
                 .max(z + MARGIN * h.y / tan_y);
         }
         // Keep the box's near face well in front of the eye even when the box is flat.
-        let extent = h.length();
         let gap = if extent > 0.0 { 0.1 * extent } else { 1.0 };
         d = d.max(h.z + gap);
+        let back = -frame.fwd;
         Camera {
             projection,
-            ..Camera::perspective(
-                centre + Vec3::new(0.0, 0.0, d),
-                centre,
-                Vec3::Y,
-                fov_y_deg,
-                aspect,
-            )
+            ..Camera::perspective(centre + d * back, centre, frame.given_up, fov_y_deg, aspect)
         }
     }
 
@@ -311,4 +331,13 @@ pub struct CameraFrame {
     pub fwd: Vec3,
     /// The unit up vector the frame was built from: the camera's own, or the fallback.
     pub given_up: Vec3,
+}
+
+impl CameraFrame {
+    /// The half-extents along (right, up, backward) of the box of half-extents `h` (along x, y,
+    /// z): the extent of its projection on each axis, |a.x|·h.x + |a.y|·h.y + |a.z|·h.z.
+    pub fn half_extent(&self, h: Vec3) -> Vec3 {
+        let along = |a: Vec3| a.abs().dot(h);
+        Vec3::new(along(self.right), along(self.up), along(-self.fwd))
+    }
 }

@@ -23,6 +23,7 @@
 //! order and clipped from its inside endpoint, so neighbouring triangles leave no cracks.
 
 mod camera;
+pub mod default_view;
 pub mod false_colour;
 pub mod gather;
 pub mod glyphs;

@@ -3,8 +3,10 @@
 //! exposure ([`RenderOptions`]), checked once for every command that draws (`solve`, `render`,
 //! `relight`).
 
+use super::default_view::{self, DefaultView, ModelView};
 use super::view_file::RadianceView;
 use super::{Camera, Projection, RenderOptions};
+use crate::intersect::Intersector;
 use crate::settings::Invalid;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -56,10 +58,32 @@ impl ViewSettings {
         check_exposure(r.exposure)
     }
 
-    /// The camera for a scene with bounds (lo, hi), at this picture's aspect.
+    /// The camera for a scene with bounds (lo, hi), at this picture's aspect (y up).
     pub fn camera_for(&self, lo: Vec3, hi: Vec3) -> Camera {
-        self.camera
-            .resolve(lo, hi, self.image.width as f32 / self.image.height as f32)
+        self.camera.resolve(lo, hi, self.aspect())
+    }
+
+    /// The camera for a model, at this picture's aspect: with no camera flag at all, the
+    /// default view ([`default_view::default_camera`]: fitted with the zenith up, or the plan
+    /// of a building seen from outside), and which it took; else the flags' camera, what they
+    /// leave out fitted with the zenith up ([`CameraSpec::resolve_up`]), and `None`.
+    pub fn camera_of<I: Intersector>(
+        &self,
+        model: &ModelView<'_, I>,
+    ) -> (Camera, Option<DefaultView>) {
+        if self.camera.is_default() {
+            let (cam, view) = default_view::default_camera(model, self.aspect());
+            return (cam, Some(view));
+        }
+        let cam = self
+            .camera
+            .resolve_up(model.lo, model.hi, self.aspect(), model.zenith);
+        (cam, None)
+    }
+
+    /// Width / height of the picture.
+    fn aspect(&self) -> f32 {
+        self.image.width as f32 / self.image.height as f32
     }
 }
 
@@ -137,10 +161,21 @@ impl CameraSpec {
         Ok(())
     }
 
+    /// No camera flag given: the picture takes the default view.
+    pub fn is_default(&self) -> bool {
+        *self == CameraSpec::default()
+    }
+
     /// The camera for a scene with bounds (lo, hi) and a picture of `aspect` (width / height):
-    /// the view's if there is one, else fitted unless an eye is given. `--near` applies to
-    /// either.
+    /// the view's if there is one, else fitted (y up) unless an eye is given. `--near` applies
+    /// to either.
     pub fn resolve(&self, lo: Vec3, hi: Vec3, aspect: f32) -> Camera {
+        self.resolve_up(lo, hi, aspect, Vec3::Y)
+    }
+
+    /// [`CameraSpec::resolve`] for a model whose up is `zenith`: what the flags leave out is
+    /// fitted with the zenith up, looking horizontally ([`default_view::fitted`]).
+    pub fn resolve_up(&self, lo: Vec3, hi: Vec3, aspect: f32, zenith: Vec3) -> Camera {
         if let Some(v) = &self.view {
             let mut cam = v.camera();
             if let Some(n) = self.near {
@@ -148,7 +183,7 @@ impl CameraSpec {
             }
             return cam;
         }
-        let mut cam = Camera::fit(lo, hi, aspect);
+        let mut cam = default_view::fitted(lo, hi, aspect, zenith);
         if let Some(n) = self.near {
             cam.near = n;
         }

@@ -75,6 +75,7 @@ pub(crate) fn export_loaded(
         scale: None,
         shading: None,
         gather: None,
+        view: None,
         warnings: Vec::new(),
     })
 }

@@ -55,6 +55,10 @@ pub struct OutputReport {
     /// What a final-gather picture cost.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub gather: Option<crate::render::gather::GatherStats>,
+    /// The default view taken when it is not the fitted one (a building's plan: why, and where
+    /// it is cut); printed as `note: …`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub view: Option<String>,
     /// What a user should hear of (printed as `warning: …`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,

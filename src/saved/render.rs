@@ -13,11 +13,13 @@ use crate::export::write_atomic;
 use crate::intersect::select::{self, IntersectorKind};
 use crate::light::{LightAt, Relit};
 use crate::progress::Progress;
+use crate::render::default_view::ModelView;
 use crate::render::false_colour;
 use crate::render::gather::{render_gather, GatherStats};
 use crate::render::{self, Camera, LinearImage, Shading, ShadingSettings, ViewSettings};
-use crate::sky::{Sky, SkySpec};
+use crate::sky::{Compass, Sky, SkySpec, DEFAULT_ZENITH};
 use crate::Error;
+use glam::Vec3;
 use std::path::PathBuf;
 
 /// Everything `radiosity render` does.
@@ -33,6 +35,9 @@ pub struct RenderJob {
     pub false_colour: bool,
     /// Final gather or Gouraud (`--shading`, `--pixel-rays`, `--seed`).
     pub shading: ShadingSettings,
+    /// The model's up for the default view (`--zenith`); left out, the zenith of the sky the
+    /// solution was solved under ([`saved_zenith`]), else +y.
+    pub zenith: Option<Vec3>,
 }
 
 /// The image format from `--out`, after checking the view and that false colour goes to PNG.
@@ -50,6 +55,9 @@ pub(crate) fn check_render_options(job: &RenderJob) -> Result<ImageKind, Error> 
     }
     job.view.check()?;
     job.shading.check()?;
+    if let Some(z) = job.zenith {
+        Compass::new(z, Compass::default_north(z))?;
+    }
     Ok(kind)
 }
 
@@ -74,6 +82,42 @@ pub fn saved_sky(sol: &SavedSolution) -> Result<Option<Sky>, String> {
         Some(v) => serde_json::from_value::<SkySpec>(v.clone()).map_err(|e| e.to_string())?,
     };
     Sky::new(&spec).map(Some).map_err(|e| e.to_string())
+}
+
+/// The zenith of the sky a saved solution was solved under (`settings.solve.sky.zenith`), the
+/// one orientation the file keeps; `None` for a solve without a sky (or a file whose sky
+/// settings this version does not read).
+pub fn saved_zenith(sol: &SavedSolution) -> Option<Vec3> {
+    let sky = sol.meta.settings.get("solve")?.get("sky")?;
+    serde_json::from_value::<SkySpec>(sky.clone())
+        .ok()
+        .map(|s| s.zenith)
+}
+
+/// The camera of a saved solution's picture: the job's, or the default view of the model
+/// ([`crate::render::default_view`]), with what a user should hear of the view taken.
+fn camera(sol: &SavedSolution, job: &RenderJob) -> (Camera, Option<String>) {
+    let (lo, hi) = bounds(sol);
+    let zenith = job
+        .zenith
+        .or_else(|| saved_zenith(sol))
+        .unwrap_or(DEFAULT_ZENITH);
+    let mesh = job.view.camera.is_default().then(|| {
+        let mut m = sol.mesh.clone();
+        m.pair_twins();
+        m
+    });
+    let built = mesh
+        .as_ref()
+        .and_then(|m| select::select(m, IntersectorKind::Auto).ok());
+    let model = ModelView {
+        lo,
+        hi,
+        zenith,
+        probe: mesh.as_ref().zip(built.as_ref().map(|(i, _)| i)),
+    };
+    let (cam, view) = job.view.camera_of(&model);
+    (cam, view.and_then(|v| v.describe()))
 }
 
 /// [`saved_sky`], or none with a warning that says what `what` (a picture, the elements) then
@@ -121,8 +165,7 @@ pub(crate) fn render_loaded(
     relit: Option<Relit>,
     progress: &Progress,
 ) -> Result<OutputReport, Error> {
-    let (lo, hi) = bounds(sol);
-    let cam = job.view.camera_for(lo, hi);
+    let (cam, view) = camera(sol, job);
     let mut exposure = None;
     let mut scale = None;
     let mut shading = None;
@@ -169,6 +212,7 @@ pub(crate) fn render_loaded(
         scale,
         shading,
         gather: gathered,
+        view,
         warnings,
     })
 }

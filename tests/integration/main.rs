@@ -30,3 +30,4 @@ mod solve_analytic;
 mod solve_methods;
 mod stiff;
 mod view;
+mod views;

@@ -1,6 +1,6 @@
 //! The commands that act on a saved solution (`solve --save`): `render`, `export`, `relight`.
 
-use super::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs};
+use super::args::{parse_weight, CheckArgs, ShadingArgs, ViewArgs, Xyz};
 use crate::outln;
 use clap::Args;
 use radiosity::progress::Progress;
@@ -29,6 +29,11 @@ pub struct RenderArgs {
     /// Irradiance in false colour on a log scale, with a legend in W/m² (PNG only).
     #[arg(long, alias = "false-color")]
     false_colour: bool,
+    /// The model's up direction X,Y,Z, for the default view (no camera flag: the zenith up,
+    /// or a building's plan) [default: the zenith of the sky the solution was solved under,
+    /// else 0,1,0].
+    #[arg(long, value_parser = Xyz::parse, allow_hyphen_values = true)]
+    zenith: Option<Xyz>,
     /// Print the report as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -46,6 +51,7 @@ impl RenderArgs {
             view: self.view.settings()?,
             false_colour: self.false_colour,
             shading: self.shading.settings(self.seed, Shading::Gather),
+            zenith: self.zenith.map(|z| z.0),
         })
     }
 }
@@ -116,6 +122,9 @@ pub fn export(a: ExportArgs) -> Result<(), radiosity::Error> {
 fn print_report(r: &OutputReport, json: bool, quiet: bool) {
     for w in &r.warnings {
         eprintln!("warning: {w}");
+    }
+    if let Some(v) = r.view.as_ref().filter(|_| !quiet && !json) {
+        eprintln!("note: {v}");
     }
     if json {
         outln!("{}", serde_json::to_string_pretty(r).unwrap_or_default());
