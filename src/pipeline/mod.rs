@@ -284,7 +284,11 @@ pub fn info(
     load: &LoadOptions,
     mesh_opts: &MeshOptions,
 ) -> Result<report::SceneInfo, Error> {
-    let model = Model::load(source, load, mesh_opts)?;
+    let mut model = Model::load(source, load, mesh_opts)?;
+    // The hidden sides need rays: Embree (or the plane merge) over the patches, as a solve's.
+    let (isect, _) = model.intersector(IntersectorKind::default())?;
+    model.mesh.contacts = model.mesh.find_contacts();
+    model.find_hidden(&isect, crate::solve::SolveSettings::default().seed);
     Ok(report::scene_info(
         &model.scene,
         &model.mesh,

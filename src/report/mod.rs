@@ -58,6 +58,10 @@ pub struct SceneInfo {
     pub back_patches: usize,
     /// Doubled faces merged into two-sided ones, and repeats dropped, at load time.
     pub merged: crate::scene::sides::Merged,
+    /// Patches whose side no light can reach (inside closed solids, under faces lying on
+    /// them: `mesh::Hidden`), their area, and the patches a face lies on (`mesh::Contacts`).
+    pub hidden: HiddenReport,
+    pub contact_patches: usize,
     pub total_area: f64,
     pub bounds_min: [f32; 3],
     pub bounds_max: [f32; 3],
@@ -146,6 +150,11 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
         intersector: auto.name(),
         intersector_reason: why,
         warnings: scene.warnings.clone(),
+        hidden: {
+            let (patches, area_m2) = mesh.hidden.count(mesh);
+            HiddenReport { patches, area_m2 }
+        },
+        contact_patches: mesh.contacts.len(),
     }
 }
 
@@ -168,6 +177,11 @@ impl std::fmt::Display for SceneInfo {
             f,
             "sides          {} back patches; {} doubled faces merged into two-sided ones, {} repeated faces dropped",
             self.back_patches, self.merged.two_sided, self.merged.repeated
+        )?;
+        writeln!(
+            f,
+            "hidden         {} patches ({:.2} m²) no light can reach (inside closed solids, under faces lying on them); {} patches with a face lying on them",
+            self.hidden.patches, self.hidden.area_m2, self.contact_patches
         )?;
         writeln!(f, "surface area   {:.4} m²", self.total_area)?;
         let (lo, hi) = (self.bounds_min, self.bounds_max);
@@ -313,7 +327,7 @@ pub struct LitBacks {
 
 /// Sides no light can reach (`mesh::Hidden`; `summary.json`: `hidden`): the patches whose side
 /// is hidden, and their area. They are black, and kept out of the black-patch counts.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize)]
 pub struct HiddenReport {
     pub patches: usize,
     pub area_m2: f64,

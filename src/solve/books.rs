@@ -121,8 +121,10 @@ pub(super) struct State {
     cube_kept: Vec<f64>,
     cube_var: Vec<f64>,
     pub channels: Option<Channels>,
-    /// Scalar flux that met the back of each one-sided surface patch (W): where the model's
-    /// winding loses light (`Solution::back`). Empty until a ray meets a back.
+    /// Scalar flux from the model's own patches that met the back of each one-sided surface
+    /// patch (W): where the model's winding loses light (`Solution::back`). The sky's and the
+    /// sun's light on backs is a one-sided model's outside, not counted. Empty until a ray
+    /// meets a back.
     pub back: Vec<f64>,
 }
 
@@ -438,10 +440,9 @@ impl State {
     /// Flux from a distant emitter that arrived on a back face (absorbed there): a one-sided
     /// model's outside, not a winding error.
     #[inline]
-    pub fn deposit_back_distant(&mut self, j: usize, phi: &[f64; 3]) {
+    pub fn deposit_back_distant(&mut self, phi: &[f64; 3]) {
         add3(&mut self.energy.absorbed_back, phi);
         add3(&mut self.energy.distant_back, phi);
-        self.note_back(j, phi);
     }
 
     /// A distant emitter's ray that missed the model.

@@ -365,11 +365,14 @@ fn reflected(b: &[[f64; 3]], e: &[Rgb], i: usize) -> f64 {
 }
 
 /// Patches with ρ > 0 and no reflected light at all by `b`, but hidden sides
-/// ([`crate::mesh::Hidden`]: black because no light can reach them, counted apart).
+/// ([`crate::mesh::Hidden`]: black because no light can reach them, counted apart) and the
+/// dark sides of two-sided surfaces whose other side is lit (they face the void or the inside
+/// of an object, as the gather's `faces_void`).
 fn black(b: &[[f64; 3]], e: &[Rgb], rho: &[Rgb], mesh: &Mesh) -> u64 {
     (0..b.len())
         .filter(|&i| light::scalar(rho[i]) > 0.0 && reflected(b, e, i) <= 0.0)
         .filter(|&i| !mesh.hidden.side(mesh, i))
+        .filter(|&i| !mesh.other_side(i).is_some_and(|o| reflected(b, e, o) > 0.0))
         .count() as u64
 }
 

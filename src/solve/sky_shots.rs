@@ -202,7 +202,7 @@ pub(super) fn shoot<I: Intersector>(
                 if code == ESCAPED {
                     st.escape_distant(&phi);
                 } else if code & BACK != 0 {
-                    st.deposit_back_distant((code & !BACK) as usize, &phi);
+                    st.deposit_back_distant(&phi);
                 } else {
                     st.deposit(code as usize, &phi);
                     if !shot_ch.is_empty() {

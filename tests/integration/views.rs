@@ -236,6 +236,7 @@ fn default_of_sided(scene: &Scene, up: Vec3, two_sided: bool) -> (Camera, Defaul
     let opts = radiosity::mesh::MeshOptions {
         patch_size: None,
         two_sided,
+        ..Default::default()
     };
     let m = radiosity::mesh::build(scene, &opts);
     let isect = EmbreeScene::build(&m, |_| true).unwrap();
