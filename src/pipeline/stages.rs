@@ -194,7 +194,8 @@ pub fn lit_backs(
             *per_polygon.entry(p.polygon).or_default() += phi;
         }
     }
-    let total: f64 = per_polygon.values().sum();
+    // `+ 0.0`: an empty sum is −0.0, which the summary would print as such.
+    let total: f64 = per_polygon.values().sum::<f64>() + 0.0;
     let mut out = LitBacks {
         back_fraction: total / emitted,
         ..LitBacks::default()
