@@ -196,11 +196,7 @@ impl Mesh {
 
 /// Area of a convex ring.
 fn area(r: &[Vec2]) -> f32 {
-    let mut a = 0.0;
-    for k in 0..r.len() {
-        a += r[k].perp_dot(r[(k + 1) % r.len()]);
-    }
-    (a * 0.5).abs()
+    area_signed(r).abs()
 }
 
 /// Area of the intersection of two convex rings (Sutherland–Hodgman clipping of one by the
@@ -239,6 +235,7 @@ fn overlap_area(a: &[Vec2], b: &[Vec2]) -> f32 {
     }
 }
 
+/// Signed area of a ring: positive when counter-clockwise.
 fn area_signed(r: &[Vec2]) -> f32 {
     let mut a = 0.0;
     for k in 0..r.len() {
