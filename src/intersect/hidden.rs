@@ -39,11 +39,7 @@ pub const PROBES: usize = 16;
 /// Finds the hidden sides of `mesh`'s surface patches. `open[j]`: surface patch j lets light
 /// through (glazing), so a ray meeting it is in the air.
 pub fn find<I: Intersector>(mesh: &Mesh, isect: &I, open: &[bool], seed: u64) -> Hidden {
-    let (lo, hi) = mesh.vertices.iter().fold(
-        (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
-        |(lo, hi), &v| (lo.min(v), hi.max(v)),
-    );
-    let eps_floor = (hi - lo).length().max(f32::MIN_POSITIVE) * 5e-7;
+    let eps_floor = mesh.ray_offset_floor();
     let grid = PolarGrid::for_samples(PROBES as f64);
     let sides: Vec<(bool, bool)> = (0..mesh.patches.len())
         .into_par_iter()

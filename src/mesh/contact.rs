@@ -86,10 +86,7 @@ impl Mesh {
     /// plane when their coordinates along the axis agree to 1e-6 of the scene's size; they are
     /// in contact when their rings overlap with an area above 1e-6 of the smaller one's.
     pub fn find_contacts(&self) -> Contacts {
-        let (lo, hi) = self.vertices.iter().fold(
-            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-            |(lo, hi), &v| (lo.min(v), hi.max(v)),
-        );
+        let (lo, hi) = self.bounds();
         let quantum = ((hi - lo).length() * 1e-6).max(f32::MIN_POSITIVE);
         // Plane → (patches facing +axis, patches facing −axis).
         type Sides = (Vec<u32>, Vec<u32>);

@@ -108,6 +108,21 @@ impl Mesh {
         !matches!(self.patches[i].side, Side::Back { .. })
     }
 
+    /// The box around the mesh's vertices (lowest, highest corner).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        (self.vertices.iter()).fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), &v| (lo.min(v), hi.max(v)),
+        )
+    }
+
+    /// Smallest offset of a ray's origin off its patch: a few ulps of the largest coordinate
+    /// (what the shooting and the hidden-side probes step by).
+    pub fn ray_offset_floor(&self) -> f32 {
+        let reach = (self.vertices.iter()).fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+        reach * 5e-7
+    }
+
     /// The vertex indices of patch `i`.
     pub fn patch_indices(&self, i: usize) -> &[u32] {
         let p = &self.patches[i];

@@ -131,16 +131,12 @@ pub(super) fn carried(st: &mut State, phi: &[f64; 3], tint: Option<[f64; 3]>) ->
 
 impl<'a, I: Intersector> RayCaster<'a, I> {
     pub fn new(mesh: &'a Mesh, isect: &'a I, seed: u64, jitter: bool) -> Self {
-        let reach = mesh
-            .vertices
-            .iter()
-            .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
         RayCaster {
             mesh,
             isect,
             seed,
             jitter,
-            eps_floor: reach * 5e-7,
+            eps_floor: mesh.ray_offset_floor(),
             trans: Vec::new(),
             tint: Vec::new(),
             lights: Vec::new(),
