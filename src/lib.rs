@@ -14,7 +14,7 @@
 //!   non-uniform hemi-cubes (Sec. 2);
 //! - [`solve`] shoots (or gathers) energy: the driver, ray shots, hemi-cube shots, the hybrid's
 //!   switch (Sec. 4), the stopping rule (Sec. 3) and the energy books;
-//! - [`light`] is the light at a point: emitters sampled by power, direct light and the sun
+//! - [`light`] is the light at a point: emitters sampled by what they give each receiver, direct light and the sun
 //!   with their MIS weights, hemisphere rays with the near-hit rule, and the point query
 //!   ([`light::LightAt`]) the final gather, the pictures, the elements and the sensors share
 //!   (it reads the solution's types from [`solve`], whose final gather calls it).

@@ -213,7 +213,9 @@ def write_rad(model: Model, path: Path, light_radiance: dict | None = None):
     """The Radiance scene: one ``plastic`` per non-emitting material (rho, no specularity), a
     ``light`` per emitting material (radiance Ke), or per emitting face when
     ``light_radiance[face]`` gives that face's radiance (emitters that also reflect: Ke + rho
-    H / pi, found by :func:`check.light_iteration`)."""
+    H / pi, found by :func:`check.light_iteration`). Emitting faces are written as the
+    parallelograms Radiance's direct light samples exactly (:func:`light_sources`). Returns
+    what was done to them (counts)."""
     out = ["# written by scripts/radiance/objrad.py: the OBJ's faces, the tool's materials"]
     for k, m in enumerate(model.materials):
         if m.emits:
@@ -236,6 +238,7 @@ def write_rad(model: Model, path: Path, light_radiance: dict | None = None):
             out.append(f"void plastic m{k}\n0\n0\n5 {m.rho[0]:.9g} {m.rho[1]:.9g} "
                        f"{m.rho[2]:.9g} 0 0")
     light_radiance = light_radiance or {}
+    emitting = {}  # modifier -> [(face, piece)]
     for i, (face, mat) in enumerate(zip(model.faces, model.face_material)):
         p = model.vertices[face]
         modifier = f"m{mat}"
@@ -243,10 +246,115 @@ def write_rad(model: Model, path: Path, light_radiance: dict | None = None):
             r = light_radiance[i]
             out.append(f"void light lf{i}\n0\n0\n3 {r[0]:.9g} {r[1]:.9g} {r[2]:.9g}")
             modifier = f"lf{i}"
+        if model.materials[mat].emits:
+            emitting.setdefault(modifier, []).extend((i, q) for q in planar_pieces(p))
+            continue
         for j, piece in enumerate(planar_pieces(p)):
             coords = " ".join(f"{c:.9g}" for c in piece.reshape(-1))
             out.append(f"{modifier} polygon f{i}_{j}\n0\n0\n{3 * len(piece)} {coords}")
+    stats = {"emitter_pieces": 0, "merged_pairs": 0, "repeats_dropped": 0, "subdivided": 0,
+             "sources": 0}
+    for modifier, pieces in emitting.items():
+        stats["emitter_pieces"] += len(pieces)
+        for k, (i, piece) in enumerate(light_sources(pieces, stats)):
+            coords = " ".join(f"{c:.9g}" for c in piece.reshape(-1))
+            out.append(f"{modifier} polygon f{i}_s{k}\n0\n0\n{3 * len(piece)} {coords}")
+            stats["sources"] += 1
     Path(path).write_text("\n".join(out) + "\n")
+    return stats
+
+
+# Radiance's direct light from a flat source samples it as a parallelogram (its parts, -ds,
+# cover the source's own rectangle): a source of another shape — a triangle, a trapezoid — is
+# off by 0.4-1.5x at receivers closer than a few times its size (scripts/radiance/README.md,
+# "Emitters Radiance can sample"). So emitting faces are written as parallelograms: triangle
+# pairs that make one (exporters' fan-triangulated rectangles) merged back, exact repeats
+# (doubled faces) dropped as the tool drops them, and any other shape cut into parallelograms
+# and triangles no longer than SOURCE_PIECE.
+SOURCE_PIECE = 0.01  # metres: the largest triangle left in a subdivided emitter
+SOURCE_DEPTH = 8  # at most 2^8 - 1 parallelograms and 2^8 triangles per triangle
+
+
+def is_parallelogram(p: np.ndarray) -> bool:
+    if len(p) != 4:
+        return False
+    size = np.ptp(p, axis=0).max()
+    return bool(np.abs(p[0] + p[2] - p[1] - p[3]).max() <= 1e-6 * max(size, 1e-9))
+
+
+def light_sources(pieces, stats):
+    """The (face, polygon) list of one light's emitting pieces, as parallelograms Radiance
+    samples exactly (see SOURCE_PIECE)."""
+    key = lambda v: tuple(np.round(v, 7))  # noqa: E731
+    tris = [(i, p) for i, p in pieces if len(p) == 3]
+    rest = [(i, p) for i, p in pieces if len(p) != 3]
+    # Merge triangles sharing an edge (in opposite directions) into parallelograms.
+    by_edge = {}
+    for t, (_, p) in enumerate(tris):
+        for e in range(3):
+            by_edge.setdefault((key(p[e]), key(p[(e + 1) % 3])), []).append((t, e))
+    used = [False] * len(tris)
+    merged = []
+    for t, (i, p) in enumerate(tris):
+        if used[t]:
+            continue
+        n = polygon_normal(p)
+        for e in range(3):
+            a, b, c = p[(e + 2) % 3], p[e], p[(e + 1) % 3]  # edge b -> c, a opposite
+            for u, f in by_edge.get((key(c), key(b)), []):
+                if used[u] or u == t:
+                    continue
+                q = tris[u][1]
+                d = q[(f + 2) % 3]
+                m = polygon_normal(q)
+                quad = np.array([a, b, d, c])
+                if np.dot(n, m) > 0.999999 * np.linalg.norm(n) * np.linalg.norm(m) and \
+                        is_parallelogram(quad):
+                    used[t] = used[u] = True
+                    merged.append((i, quad))
+                    stats["merged_pairs"] += 1
+                    break
+            if used[t]:
+                break
+        if not used[t]:
+            merged.append((i, p))
+    # Drop exact repeats (the same polygon facing the same way).
+    seen, unique = set(), []
+    for i, p in merged + rest:
+        k = (frozenset(key(v) for v in p), tuple(np.sign(np.round(polygon_normal(p), 9))))
+        if k in seen:
+            stats["repeats_dropped"] += 1
+            continue
+        seen.add(k)
+        unique.append((i, p))
+    out = []
+    for i, p in unique:
+        if len(p) == 4 and is_parallelogram(p):
+            out.append((i, p))
+            continue
+        stats["subdivided"] += 1
+        for r in range(1, len(p) - 1):
+            out.extend((i, q) for q in parallelogram_pieces(np.array([p[0], p[r], p[r + 1]])))
+    return out
+
+
+def parallelogram_pieces(t: np.ndarray):
+    """Triangle ``t`` (a, b, c) as parallelograms and small triangles, all wound as ``t``: the
+    parallelogram (mid ab, b, mid bc, mid ca) and the triangles (a, mid ab, mid ca) and
+    (mid ca, mid bc, c), the triangles cut again until none is longer than SOURCE_PIECE."""
+    size = max(np.linalg.norm(t[k] - t[(k + 1) % 3]) for k in range(3))
+    depth = min(SOURCE_DEPTH, max(0, math.ceil(math.log2(max(size / SOURCE_PIECE, 1.0)))))
+    todo, out = [(t, depth)], []
+    while todo:
+        (a, b, c), d = todo.pop()
+        if d == 0:
+            out.append(np.array([a, b, c]))
+            continue
+        ab, bc, ca = (a + b) / 2, (b + c) / 2, (c + a) / 2
+        out.append(np.array([ab, b, bc, ca]))
+        todo.append((np.array([a, ab, ca]), d - 1))
+        todo.append((np.array([ca, bc, c]), d - 1))
+    return out
 
 
 def face_points(p: np.ndarray, k: int, rng: np.random.Generator, shrink=0.98):

@@ -1,8 +1,9 @@
 //! Direct light from the emitting patches: shadow rays from a point to points drawn on the
-//! emitters by power ([`super::emitters`]), each sample E_j·cosθ_i·cosθ_j/(π r²) divided by
+//! emitters by what they can give it, or by power ([`super::emitters`]), each sample E_j·cosθ_i·cosθ_j/(π r²) divided by
 //! its density and counted at its MIS weight against the hemisphere rays (the balance
 //! heuristic, `Emitters::weight`).
 
+use super::emitters::Emitters;
 use super::gather::{latin, stratified_var, Gathered, Split, Spot};
 use super::{scalar, Kernel, Origin, Rgb};
 use crate::intersect::{Intersector, Ray};
@@ -64,31 +65,31 @@ impl<I: Intersector> Kernel<'_, I> {
     }
 
     /// One light sample from `from` to the point `y` of emitter `e` (an index into the
-    /// emitters, of power `w`), its shadow ray weighed by MIS against `n_l` light samples and
-    /// `n_c` hemisphere rays and divided by the sample's density. Returns the sample (RGB; 0
-    /// when not seen), the emitting patch, and whether a ray was cast.
+    /// emitters, picked with probability `mass`), its shadow ray weighed by MIS against `n_l`
+    /// light samples and `n_c` hemisphere rays and divided by the sample's density. Returns
+    /// the sample (RGB; 0 when not seen), the emitting patch, and whether a ray was cast.
     pub(super) fn light_sample(
         &self,
         from: &Origin,
-        (e, w): (usize, f64),
+        (e, mass): (usize, f64),
         y: Vec3,
         (n_l, n_c): (f64, f64),
     ) -> (Rgb, usize, bool) {
-        let em = &self.emitters;
-        let j = em.patches[e];
+        let j = self.emitters.patches[e];
+        let area = self.mesh.patches[j].area;
         let shadow = self.direct(from, j, y);
         let cast = shadow.is_some();
         let (c, mis) = shadow.map_or((Rgb::ZERO, 0.0), |sh| {
-            let mis = em.weight(self.sol.e[j], sh.cos_i, sh.cos_j, sh.dist, n_l, n_c);
-            (sh.e_g, mis)
+            let geometry = (sh.cos_i, sh.cos_j, sh.dist);
+            (sh.e_g, Emitters::weight(mass, area, geometry, n_l, n_c))
         });
-        // ÷ pdf(y) = (E_j·A_j / Σ E·A) / A_j, × the light sample's MIS weight.
-        let scale = em.power * self.mesh.patches[j].area / w * mis;
+        // ÷ pdf(y) = mass / A_j, × the light sample's MIS weight.
+        let scale = area / mass * mis;
         (c * scale, j, cast)
     }
 
     /// The emitters' part of a gather at `spot`: `split.direct` light samples, emitters by
-    /// power (stratified along the CDF), points on them uniform, paired with the points in
+    /// `split.draw` (stratified along its CDF), points on them uniform, paired with the points in
     /// random order, into `g` (its mean, the emitters' channels and the variance).
     pub(super) fn direct_part<R: Rng>(
         &self,
@@ -106,9 +107,9 @@ impl<I: Intersector> Kernel<'_, I> {
         for (&(u, v), &(s, t)) in here.iter().zip(&there) {
             let from = spot.origin(u, v);
             // Stratified choice of the emitter, then a point on it from the rest of `s`.
-            let (e, w, s2) = self.emitters.pick(f64::from(s));
+            let (e, mass, s2) = self.emitters.pick(&split.draw, f64::from(s));
             let y = self.emitters.points[e].at(s2, t);
-            let (val, j, cast) = self.light_sample(&from, (e, w), y, (split.nl, split.nc));
+            let (val, j, cast) = self.light_sample(&from, (e, mass), y, (split.nl, split.nc));
             g.rays += u64::from(cast);
             m.push(scalar(spot.rho * val));
             sum += val;

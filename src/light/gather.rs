@@ -4,6 +4,7 @@
 //! rays shared out between them and their estimates combined by multiple importance sampling
 //! (see the module notes of [`super`]); with the variance of its mean, from the strata.
 
+use super::emitters::{Draw, Receiver};
 use super::{Kernel, Origin, Rgb};
 use crate::intersect::Intersector;
 use crate::sample::polar::PolarGrid;
@@ -72,6 +73,9 @@ pub(crate) struct Ask {
 /// How a gather's rays are shared out: light samples of the emitters and of the sun, the
 /// hemisphere's polar grid, and the counts the MIS weights use.
 pub(super) struct Split {
+    /// How the light samples pick their emitters (and what the MIS weights take as their
+    /// density).
+    pub draw: Draw,
     pub direct: usize,
     pub sun: usize,
     pub grid: PolarGrid,
@@ -81,7 +85,8 @@ pub(super) struct Split {
 
 impl Split {
     /// `rays_wanted` rays for `parts`, with emitters to sample (`lamps`) and a `sun` or not.
-    fn new(parts: LightParts, lamps: bool, sun: bool, rays_wanted: usize) -> Split {
+    fn new(parts: LightParts, draw: Option<Draw>, sun: bool, rays_wanted: usize) -> Split {
+        let lamps = draw.is_some();
         let (direct, n_sun) = match (parts, lamps, sun) {
             (LightParts::Indirect, _, _) => (0, 0),
             (LightParts::All, l, s) => (
@@ -109,6 +114,7 @@ impl Split {
             LightParts::Direct | LightParts::Indirect => (if lamps { 1.0 } else { 0.0 }, 1.0),
         };
         Split {
+            draw: draw.unwrap_or_else(Draw::by_power),
             direct,
             sun: n_sun,
             grid,
@@ -129,8 +135,16 @@ impl<I: Intersector> Kernel<'_, I> {
             rays: 0,
         };
         let lamps = !self.emitters.is_empty() && ask.lights;
+        // A whole gather draws its emitters by what they can give this spot (none: no light
+        // samples at all); a gather split in parts, each gathered at other points
+        // (`LightParts`), by power, so that the parts' MIS weights still add up to one.
+        let draw = match (lamps, ask.parts) {
+            (false, _) => None,
+            (true, LightParts::All) => self.emitters.draw_for(&self.receiver(spot)),
+            (true, _) => Some(Draw::by_power()),
+        };
         let sun = self.sky.sun();
-        let split = Split::new(ask.parts, lamps, sun.is_some(), ask.rays);
+        let split = Split::new(ask.parts, draw, sun.is_some(), ask.rays);
         if split.direct > 0 {
             self.direct_part(spot, &split, &mut g, rng);
         }
@@ -141,6 +155,29 @@ impl<I: Intersector> Kernel<'_, I> {
             self.hemisphere_part(spot, &split, &mut g, rng);
         }
         g
+    }
+}
+
+impl<I> Kernel<'_, I> {
+    /// The receiver a spot's emitters are weighed for: its patch (centre, normal and the
+    /// distance to its farthest corner), or the sensor's point.
+    fn receiver(&self, spot: &Spot) -> Receiver {
+        if spot.patch == super::NO_PATCH {
+            return Receiver {
+                centre: (spot.at)(0.5, 0.5),
+                normal: spot.n,
+                radius: 0.0,
+            };
+        }
+        let p = &self.mesh.patches[spot.patch];
+        let radius = (self.mesh.patch_indices(spot.patch).iter())
+            .map(|&v| self.mesh.vertices[v as usize].distance(p.centre))
+            .fold(0.0f32, f32::max);
+        Receiver {
+            centre: p.centre,
+            normal: spot.n,
+            radius,
+        }
     }
 }
 

@@ -4,6 +4,7 @@
 //! the point it met when nearer than that side's size (the near-hit rule, [`NEAR`]) — plus an
 //! emitter's E at the hemisphere ray's MIS weight.
 
+use super::emitters::{Draw, Emitters};
 use super::gather::{latin, stratified_var, Gathered, Split, Spot};
 use super::{add_to, scalar, Kernel, Origin, Rgb, NO_PATCH};
 use crate::intersect::{Hit, Intersector, Ray};
@@ -87,19 +88,27 @@ impl<I: Intersector> Kernel<'_, I> {
 
     /// What emitter `r`, met at distance `t` by a hemisphere ray along `dir` from a point
     /// facing `n`, adds to it: its E on its emitting side, times the complement of the weight
-    /// its light samples have (none when there are none, `n_l` = 0).
-    fn emitted_towards(&self, r: usize, n: Vec3, dir: Vec3, t: f32, n_l: f64, n_c: f64) -> Rgb {
+    /// its light samples (drawn by `draw`) have (none when there are none, `n_l` = 0).
+    fn emitted_towards(
+        &self,
+        r: usize,
+        (n, dir, t): (Vec3, Vec3, f32),
+        draw: &Draw,
+        (n_l, n_c): (f64, f64),
+    ) -> Rgb {
         let e = self.sol.e[r];
         let mut emitted = Rgb::ZERO;
         if scalar(e) > 0.0 {
-            let cos_r = -f64::from(self.mesh.patches[r].normal.dot(dir));
+            let p = &self.mesh.patches[r];
+            let cos_r = -f64::from(p.normal.dot(dir));
             if cos_r > 0.0 {
-                let w = if n_l > 0.0 {
-                    let cos_i = f64::from(n.dot(dir));
-                    self.emitters
-                        .weight(e, cos_i, cos_r, f64::from(t), n_l, n_c)
-                } else {
-                    0.0
+                let w = match self.emitters.index_of(r).filter(|_| n_l > 0.0) {
+                    Some(ei) => {
+                        let cos_i = f64::from(n.dot(dir));
+                        let mass = self.emitters.mass(draw, ei, scalar(e) * p.area);
+                        Emitters::weight(mass, p.area, (cos_i, cos_r, f64::from(t)), n_l, n_c)
+                    }
+                    None => 0.0,
                 };
                 emitted = e * (1.0 - w);
             }
@@ -140,7 +149,12 @@ impl<I: Intersector> Kernel<'_, I> {
             let mut sub = Reflected::default();
             if let Some((r, t)) = recv {
                 if split.nl > 0.0 {
-                    emitted = self.emitted_towards(r, spot.n, dir, t, split.nl, split.nc);
+                    emitted = self.emitted_towards(
+                        r,
+                        (spot.n, dir, t),
+                        &split.draw,
+                        (split.nl, split.nc),
+                    );
                 }
                 sub = self.reflected_at(r, org + dir * t, t, 0, rng);
                 g.rays += sub.rays;
@@ -234,9 +248,9 @@ impl<I: Intersector> Kernel<'_, I> {
         let nl = if self.emitters.is_empty() { 0.0 } else { 1.0 };
         // One light sample.
         if nl > 0.0 {
-            let (e, w, _) = self.emitters.pick(rng.gen());
+            let (e, mass, _) = self.emitters.pick(&Draw::by_power(), rng.gen());
             let yj = self.emitters.points[e].at(rng.gen(), rng.gen());
-            let (v, j, cast) = self.light_sample(&from, (e, w), yj, (1.0, 1.0));
+            let (v, j, cast) = self.light_sample(&from, (e, mass), yj, (1.0, 1.0));
             if cast {
                 acc.rays += 1;
                 acc.v += v;
@@ -274,7 +288,7 @@ impl<I: Intersector> Kernel<'_, I> {
             add_to(&mut acc.ch, self.sky.sun_channel, l, Rgb::ONE);
         }
         if let Some((s, t2)) = self.receiver_of(hit) {
-            let emitted = self.emitted_towards(s, n, dir, t2, nl, 1.0);
+            let emitted = self.emitted_towards(s, (n, dir, t2), &Draw::by_power(), (nl, 1.0));
             let sub = self.reflected_at(s, x + dir * t2, t2, depth + 1, rng);
             acc.rays += sub.rays;
             acc.v += w * (sub.v + emitted);

@@ -9,11 +9,13 @@
 //! The irradiance H at a point x facing n ([`gather`]) is the sum of three estimates:
 //!
 //! - **Direct light** by sampling the emitters explicitly ([`emitters`], [`direct`]): an
-//!   emitting patch j drawn in proportion to its power E_j·A_j (a CDF over the emitting
-//!   patches, stratified), a point y uniform on it, a shadow ray from x. The ray must reach
+//!   emitting patch j drawn with probability P_j — by an estimate of the irradiance its
+//!   cluster of emitters gives the receiver, mixed with a share by power E_j·A_j (a CDF,
+//!   stratified; none where no emitter can light the receiver) — a point y uniform on it, a
+//!   shadow ray from x. The ray must reach
 //!   j's emitting side (a one-sided emitter emits from its front only; a back twin from the
 //!   back of its surface, `Mesh::receiver`) with nothing before it; the sample is
-//!   E_j·cosθ_i·cosθ_j/(π r²) / p(y), p(y) = (E_j·A_j / Σ E·A) / A_j.
+//!   E_j·cosθ_i·cosθ_j/(π r²) / p(y), p(y) = P_j / A_j.
 //! - **The sun** ([`sun`]): directions over its disc, shadow rays that must leave the model;
 //!   rays that leave it otherwise see the sky's radiance (an exitance π·L, the unit of B).
 //! - **Indirect light** by cosine-weighted rays ([`hemisphere`]; the stratified polar grid of

@@ -13,7 +13,7 @@
 //! SIGGRAPH 1993: the radiosity solution used as the indirect source of a per-point gather).
 //!
 //! **How** a patch gathers is the light kernel's ([`crate::light`]): direct light by shadow
-//! rays to the emitters drawn by power, the sun, cosine-weighted hemisphere rays returning the
+//! rays to the emitters drawn by what they give the patch, the sun, cosine-weighted hemisphere rays returning the
 //! solved B − E of the side they meet (near hits followed, [`crate::light::NEAR`]), combined
 //! by multiple importance sampling, at points stratified over the patch
 //! (`PatchPoints::at`, Latin hypercube). B_i^gather = E_i + ρ_i·H_i (RGB, f64), with the
