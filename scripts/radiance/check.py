@@ -152,10 +152,11 @@ class Radiance:
                      "-dj", "0", "-dr", "0", "-u+"]
         self.seconds = 0.0
         self.rays = 0
+        self.sources = {}
 
     def octree(self, model, name, light_radiance=None):
         rad = self.workdir / f"{name}.rad"
-        objrad.write_rad(model, rad, light_radiance)
+        self.sources = objrad.write_rad(model, rad, light_radiance)
         return oconv(self.bin, self.env, [rad], self.workdir / f"{name}.oct")
 
     def irradiance(self, octree: Path, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
@@ -300,6 +301,40 @@ def compare_solve(label, table, summary, wall, ids, weight, y_ref, model, n_wors
     }
 
 
+def reference_points(args, rad, octree, polys, ids):
+    """Radiance's mean irradiance (RGB) over each sampled patch, per run, and the points per
+    patch and run. Each run starts with ``--points`` stratified points per patch; a patch whose
+    points still spread so that the standard error of their mean exceeds ``--point-error`` of
+    it (of 5 % of the median patch's, for dark patches) gets three times as many again in every
+    run, up to ``--max-points`` per run: a patch half under books, lit on a strip of it, is 0.03
+    from 8 points and 0.073 from 120 (docs/results/converted-models.md)."""
+    n, k = len(ids), args.points
+    sums = np.zeros((args.repeat, n, 3))
+    count = np.zeros(n, dtype=int)
+    s1, s2 = np.zeros(n), np.zeros(n)
+    todo, batch, step = np.arange(n), k, 0
+    while len(todo):
+        for r in range(args.repeat):
+            seed = args.seed + 1 + r + 1000 * step
+            pts, nrm = points_for(polys, ids[todo], batch, seed)
+            h = rad.irradiance(octree, pts, nrm).reshape(len(todo), batch, 3)
+            sums[r, todo] += h.sum(axis=1)
+            y = h @ LUMA
+            s1[todo] += y.sum(axis=1)
+            s2[todo] += (y * y).sum(axis=1)
+        count[todo] += batch
+        total = count * args.repeat
+        mean = s1 / total
+        se = np.sqrt(np.maximum(s2 / total - mean ** 2, 0.0) / np.maximum(total - 1, 1))
+        lit = mean > 0
+        floor = 0.05 * (np.median(mean[lit]) if lit.any() else 0.0)
+        batch = 3 * int(count[todo[0]])
+        want = se > args.point_error * np.maximum(mean, floor)
+        todo = np.flatnonzero(want & (count + batch <= args.max_points))
+        step += 1
+    return sums / count[None, :, None], count
+
+
 def radiance_reference(args, model, rad, table, polys, ids, weight):
     """Radiance's irradiance at the sampled patches' points: runs, noise, lit-behind ids."""
     t0 = time.perf_counter()
@@ -308,11 +343,7 @@ def radiance_reference(args, model, rad, table, polys, ids, weight):
     light_seconds = time.perf_counter() - t0
     octree = rad.octree(model, "scene", light_radiance)
     rad.seconds = 0.0
-    runs = []
-    for r in range(args.repeat):
-        pts, nrm = points_for(polys, ids, args.points, args.seed + 1 + r)
-        h = rad.irradiance(octree, pts, nrm)
-        runs.append(h.reshape(len(ids), args.points, 3).mean(axis=1))
+    runs, points = reference_points(args, rad, octree, polys, ids)
     radiance_seconds = rad.seconds
     y_runs = np.array([h @ LUMA for h in runs])
     y_ref = y_runs.mean(axis=0)
@@ -340,6 +371,8 @@ def radiance_reference(args, model, rad, table, polys, ids, weight):
         lit_behind = [int(ids[d]) for d, y in zip(dark, hb @ LUMA) if y > 0.01 * med]
 
     return {"y_runs": y_runs.tolist(), "noise": noise, "lit_behind": lit_behind,
+            "sources": rad.sources,
+            "points_per_patch": points.tolist(),
             "light_history": light_history, "light_seconds": light_seconds,
             "seconds": radiance_seconds}
 
@@ -357,6 +390,12 @@ def main():
     ap.add_argument("--radiosity", help=BINARY_HELP)
     ap.add_argument("--samples", type=int, default=1000, help="patches sampled (default 1000)")
     ap.add_argument("--points", type=int, default=8, help="points per patch (default 8)")
+    ap.add_argument("--point-error", type=float, default=0.02,
+                    help="more points for a patch until the standard error of its points' mean "
+                    "is below this fraction of it (default 0.02)")
+    ap.add_argument("--max-points", type=int, default=128,
+                    help="at most this many points per patch and run (default 128: 8, then 32, "
+                    "then 128, each step 4 times the last)")
     ap.add_argument("--seed", type=int, default=1, help="seed of the sampling")
     ap.add_argument("--repeat", type=int, default=2,
                     help="Radiance runs with independent points (their spread is the reference's "
@@ -402,6 +441,7 @@ def main():
     key = {"model": str(model_path), "bytes": model_path.stat().st_size,
            "mtime": model_path.stat().st_mtime, "rtrace": " ".join(rad.opts),
            "ids": [int(i) for i in ids], "points": args.points, "seed": args.seed,
+           "point_error": args.point_error, "max_points": args.max_points,
            "repeat": args.repeat, "light_passes": args.light_passes,
            "emit": arg_sets[0]}
     saved = out / "radiance.json"
@@ -439,8 +479,12 @@ def main():
         "points_per_patch": args.points,
         "radiance": {"rtrace": " ".join(rad.opts), "version": "pyradiance 1.3.1 (RADIANCE 6.0a)",
                      "repeat": args.repeat, "noise": noise, "seconds": radiance_seconds,
-                     "points": int(len(ids) * args.points * args.repeat),
+                     "points": int(np.sum(cached.get("points_per_patch", [args.points] * len(ids)))
+                                   * args.repeat),
+                     "patches_refined": int(np.sum(np.array(cached.get(
+                         "points_per_patch", [args.points] * len(ids))) > args.points)),
                      "light_passes": light_history, "light_pass_seconds": light_seconds,
+                     "sources": cached.get("sources", rad.sources),
                      "runs_Y": y_runs.tolist()},
         "warnings": model.warnings,
         "lit_behind_ids": lit_behind,
@@ -454,7 +498,8 @@ def print_table(r, out):
     """The short table: one column per solve."""
     rad = r["radiance"]
     print(f"{r['model']}: {r['patches']} patches, {r['sampled']} sampled x "
-          f"{r['points_per_patch']} points x {rad['repeat']} Radiance runs")
+          f"{r['points_per_patch']} points x {rad['repeat']} Radiance runs "
+          f"({rad.get('patches_refined', 0)} patches given more points)")
     if rad["noise"]:
         print(f"  Radiance noise (its mean): {100 * rad['noise']['area_weighted']:.2f} % "
               f"area-weighted, {100 * rad['noise']['median_patch']:.2f} % median patch; "
