@@ -252,6 +252,11 @@ def figures(y_tool, y_ref, area, weight):
                                               / np.sum(aw * y_ref)),
         "area_weighted_signed_error": float(np.sum(aw * (y_tool - y_ref)) / np.sum(aw * y_ref)),
         "median_patch_relative_error": weighted_median(rel[lit], weight[lit]),
+        # The paper's average weighted percent error over the lit patches (what the tool's
+        # error_estimate.weighted_percent estimates), and the gross ones.
+        "mean_patch_relative_error": float(np.sum(weight[lit] * rel[lit]) / np.sum(weight[lit]))
+        if lit.any() else 0.0,
+        "off_by_100_percent": int(np.sum(rel[lit] >= 1.0)),
         "black_where_lit": int(black.sum()),
         "black_where_lit_area_share": float(np.sum(aw[black]) / np.sum(aw)),
         "median_reference_irradiance_Y": med_ref,
@@ -508,6 +513,8 @@ def print_table(r, out):
             ("area-weighted error %", lambda s: f"{100 * s['figures']['area_weighted_relative_error']:.2f}"),
             ("  signed %", lambda s: f"{100 * s['figures']['area_weighted_signed_error']:+.2f}"),
             ("median patch error %", lambda s: f"{100 * s['figures']['median_patch_relative_error']:.2f}"),
+            ("mean patch error %", lambda s: f"{100 * s['figures'].get('mean_patch_relative_error', 0):.2f}"),
+            ("lit patches >= 100 % off", lambda s: str(s["figures"].get("off_by_100_percent", "-"))),
             ("black where lit", lambda s: str(s["figures"]["black_where_lit"])),
             ("dark front, lit back", lambda s: str(s["figures"]["dark_front_lit_back"])),
             ("tool solve s", lambda s: f"{s['times']['tool_solve_seconds']:.2f}"),
