@@ -2,10 +2,10 @@
 //! weight of such a sample against a hemisphere ray for the same direction (Veach & Guibas,
 //! *Optimally Combining Sampling Techniques for Monte Carlo Rendering*, SIGGRAPH 1995, Sec. 3).
 //!
-//! **Two ways to draw an emitter.** By power alone ([`Draw::by_power`]): a patch j chosen in
+//! **Two ways to draw an emitter.** By power alone (`Draw::by_power`): a patch j chosen in
 //! proportion to E_j·A_j (a CDF over the emitting patches, walked with a stratified number),
 //! a point uniform on it. Or by what each emitter can give the receiver at hand
-//! ([`Emitters::draw_for`]): the emitting patches are grouped into at most [`CLUSTERS`]
+//! (`Emitters::draw_for`): the emitting patches are grouped into at most [`CLUSTERS`]
 //! clusters (each patch its own when there are no more; otherwise neighbours of one facing,
 //! in Morton order), and each cluster is weighed by an estimate of the irradiance it gives the
 //! receiver's centre — its power over π d², the cosines at both ends loosened by the
