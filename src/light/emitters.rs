@@ -162,11 +162,6 @@ impl Emitters {
         self.patches.is_empty()
     }
 
-    /// How many patches emit.
-    pub fn len(&self) -> usize {
-        self.patches.len()
-    }
-
     /// The emitter (index into `patches`) of patch `j`, if it emits.
     pub fn index_of(&self, j: usize) -> Option<usize> {
         self.patches.binary_search(&j).ok()

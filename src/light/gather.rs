@@ -169,13 +169,18 @@ impl<I> Kernel<'_, I> {
                 radius: 0.0,
             };
         }
-        let p = &self.mesh.patches[spot.patch];
-        let radius = (self.mesh.patch_indices(spot.patch).iter())
+        self.patch_receiver(spot.patch)
+    }
+
+    /// Patch `i` as a receiver: its centre, normal and the distance to its farthest corner.
+    pub(super) fn patch_receiver(&self, i: usize) -> Receiver {
+        let p = &self.mesh.patches[i];
+        let radius = (self.mesh.patch_indices(i).iter())
             .map(|&v| self.mesh.vertices[v as usize].distance(p.centre))
             .fold(0.0f32, f32::max);
         Receiver {
             centre: p.centre,
-            normal: spot.n,
+            normal: p.normal,
             radius,
         }
     }

@@ -33,10 +33,6 @@ pub struct LightAt<'a, I> {
     facing: Vec<OnceLock<bool>>,
 }
 
-/// Above this many emitting patches, every patch is taken as facing one (the test is O(emitters)
-/// per patch seen).
-const FACING_TEST_MAX: usize = 4096;
-
 /// What a ray from the camera met ([`LightAt::view`]).
 #[derive(Clone, Copy, Debug)]
 pub struct ViewHit {
@@ -106,31 +102,14 @@ impl<'a, I: Intersector> LightAt<'a, I> {
         }
     }
 
-    /// Whether some emitter could light `patch`: one with a corner in front of the patch's
-    /// plane while the patch has a corner in front of the emitter's (a planar emitter lights
-    /// its front only; a patch receives on its front only). When none does — a ceiling beside
-    /// its flush lamps — light samples could only miss, so the gather's rays all go over the
-    /// hemisphere instead: half the noise variance where the picture is lit indirectly alone.
+    /// Whether some emitter could light `patch`: the emitters' own test, a cluster with a
+    /// part in front of the patch's plane while the patch is not wholly behind it
+    /// (`Emitters::draw_for`). When none can — a ceiling beside its flush lamps — light samples
+    /// could only miss, so the gather's rays all go over the hemisphere instead: half the noise
+    /// variance where the picture is lit indirectly alone.
     fn lit_by_an_emitter(&self, patch: usize) -> bool {
         let k = &self.kernel;
-        if k.emitters.len() > FACING_TEST_MAX {
-            return true;
-        }
-        let mesh = k.mesh;
-        let tol = k.eps_floor;
-        let corners = |i: usize| {
-            mesh.patch_indices(i)
-                .iter()
-                .map(|&v| mesh.vertices[v as usize])
-        };
-        let in_front = |i: usize, of: usize| {
-            let (n, c) = (mesh.patches[of].normal, mesh.patches[of].centre);
-            corners(i).any(|v| n.dot(v - c) > tol)
-        };
-        k.emitters
-            .patches
-            .iter()
-            .any(|&j| j != patch && in_front(j, patch) && in_front(patch, j))
+        k.emitters.draw_for(&k.patch_receiver(patch)).is_some()
     }
 
     /// What the ray from `org` along `dir` sees. The backs of one-sided patches are passed
