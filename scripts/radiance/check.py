@@ -418,7 +418,14 @@ def main():
                     help="reuse Radiance's result saved in --out when made for the same model, "
                          "points and settings (to compare solver changes quickly)")
     ap.add_argument("--worst", type=int, default=10, help="worst patches listed")
+    ap.add_argument("--compare", action="append", default=[], type=Path, metavar="CSV",
+                    help="no solve, no Radiance: compare this patches.csv (of a solve made "
+                    "elsewhere, on the same patches) against the reference saved in --out by an "
+                    "earlier check; repeatable")
     args = ap.parse_args()
+    if args.compare:
+        compare_saved(args)
+        return
 
     model_path = args.model.resolve()
     out = (args.out or ROOT / "out" / "check" / model_path.stem).resolve()
@@ -497,6 +504,49 @@ def main():
     }
     (out / "report.json").write_text(json.dumps(report, indent=1))
     print_table(report, out)
+
+
+def compare_saved(args):
+    """``--compare``: each CSV's figures against the reference an earlier check saved in
+    --out, on the patches it sampled (the same ids and weights), with the signed error per
+    material (its share of the area-weighted reference)."""
+    out = (args.out or ROOT / "out" / "check" / args.model.resolve().stem).resolve()
+    saved = out / "radiance.json"
+    if not saved.is_file():
+        sys.exit(f"{saved}: no saved reference (run the check once without --compare)")
+    cached = json.loads(saved.read_text())
+    base = read_patches(out / "solve" / "patches.csv")
+    ids, weight = sample_patches(base, args.samples, args.seed)
+    if [int(i) for i in ids] != cached["key"]["ids"]:
+        sys.exit(f"{saved}: sampled for other patches (--samples and --seed as the check's)")
+    y_ref = np.array(cached["y_runs"]).mean(axis=0)
+    binary = radiosity_binary(args.radiosity, must_exist=True)
+    model = objrad.read_obj(args.model.resolve(), binary, parse_emit(cached["key"]["emit"]))
+    print(f"against {saved}: {len(ids)} patches, Radiance noise "
+          f"{100 * cached['noise'].get('area_weighted', 0):.2f} %")
+    for csv in args.compare:
+        table = read_patches(csv)
+        if len(table) != len(base) or not np.allclose(
+                [table[c] for c in ("cx", "cy", "cz")], [base[c] for c in ("cx", "cy", "cz")]):
+            print(f"{csv}: not the same patches as {out / 'solve'}; skipped")
+            continue
+        h_tool, _, _, rho = tool_irradiance(table)
+        y_tool = h_tool[ids] @ LUMA
+        area = table["area"][ids]
+        fig = figures(y_tool, y_ref, area, weight)
+        print(f"{csv}: area-weighted {100 * fig['area_weighted_relative_error']:.2f} %, signed "
+              f"{100 * fig['area_weighted_signed_error']:+.2f} %, median "
+              f"{100 * fig['median_patch_relative_error']:.2f} %, mean "
+              f"{100 * fig['mean_patch_relative_error']:.2f} %, >= 100 % off "
+              f"{fig['off_by_100_percent']}")
+        aw = area * weight
+        total = np.sum(aw * y_ref)
+        names = [material_by_rho(model, rho[i]) for i in ids]
+        for name in sorted(set(names)):
+            m = np.array([n == name for n in names])
+            print(f"    {name[:28]:<28} {m.sum():>4} patches  signed "
+                  f"{100 * np.sum(aw[m] * (y_tool[m] - y_ref[m])) / total:+.2f} %  abs "
+                  f"{100 * np.sum(aw[m] * np.abs(y_tool[m] - y_ref[m])) / total:.2f} %")
 
 
 def print_table(r, out):
