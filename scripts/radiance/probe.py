@@ -82,6 +82,7 @@ def main():
     ap.add_argument("--points", type=int, default=400)
     ap.add_argument("--ab", type=int, default=12)
     ap.add_argument("--ad", type=int, default=1024)
+    ap.add_argument("--lw", type=float, default=1e-4, help="rtrace -lw (default 1e-4)")
     ap.add_argument("--seed", type=int, default=5)
     args = ap.parse_args()
     bin_, env = radiance_env()
@@ -90,7 +91,7 @@ def main():
     n /= np.linalg.norm(n)
     pts = uniform_points(poly, args.points, np.random.default_rng(args.seed))
     opts = ["-h", "-I+", "-n", "2", "-ab", str(args.ab), "-ad", str(args.ad), "-as", "0",
-            "-aa", "0", "-lr", "-12", "-lw", "1e-4", "-dt", "0", "-dc", "1", "-ds", "0.02",
+            "-aa", "0", "-lr", "-12", "-lw", str(args.lw), "-dt", "0", "-dc", "1", "-ds", "0.02",
             "-dj", "0", "-dr", "0", "-u+"]
     res = subprocess.run([str(bin_ / "rtrace"), *opts, str(args.run / "scene.oct")],
                          input=ray_lines(pts, np.repeat(n[None], len(pts), axis=0)),
