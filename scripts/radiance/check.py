@@ -116,6 +116,12 @@ def tool_irradiance(table):
     return h, b, e, rho
 
 
+def same_patches(a, b) -> bool:
+    """Whether two patches.csv tables hold the same patches (count and centres)."""
+    return len(a) == len(b) and np.allclose([a[c] for c in ("cx", "cy", "cz")],
+                                            [b[c] for c in ("cx", "cy", "cz")])
+
+
 def sample_patches(table, n: int, seed: int):
     """Patch ids sampled in STRATA area strata (equal patch counts), with their weights."""
     e = np.stack([table["e_r"], table["e_g"], table["e_b"]], axis=1)
@@ -439,9 +445,7 @@ def main():
         sub = out if k == 0 else out / f"also{k}"
         table, polys, summary, wall = solve(binary, model_path, sub, solve_args)
         if solves:
-            t0 = solves[0][1]
-            if len(table) != len(t0) or not np.allclose(
-                    [table[c] for c in ("cx", "cy", "cz")], [t0[c] for c in ("cx", "cy", "cz")]):
+            if not same_patches(table, solves[0][1]):
                 sys.exit(f"--also {shlex.join(solve_args)}: not the same patches as the first solve")
         solves.append((solve_args, table, polys, summary, wall))
     table, polys = solves[0][1], solves[0][2]
@@ -526,8 +530,7 @@ def compare_saved(args):
           f"{100 * cached['noise'].get('area_weighted', 0):.2f} %")
     for csv in args.compare:
         table = read_patches(csv)
-        if len(table) != len(base) or not np.allclose(
-                [table[c] for c in ("cx", "cy", "cz")], [base[c] for c in ("cx", "cy", "cz")]):
+        if not same_patches(table, base):
             print(f"{csv}: not the same patches as {out / 'solve'}; skipped")
             continue
         h_tool, _, _, rho = tool_irradiance(table)
