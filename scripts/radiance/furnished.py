@@ -68,6 +68,11 @@ from common import r6  # noqa: E402
 
 VARIANTS = ("plain", "doubled", "inside-out")
 CONVERTED_VARIANTS = ("plain", "doubled", "inside-out", "mixed")
+# The converted style's features, each of which `--without` can leave out (to find which of
+# them a difference to Radiance comes with): furniture uncut where it touches, bottoms kept and
+# sunk into the floor; luminaires as boxes and hung panels; the partition of overlapping boxes
+# and the column through floor and ceiling; every polygon as fan triangles.
+FEATURES = ("contacts", "luminaires", "solids", "triangles")
 SINK = 0.01  # how far the converted style sinks furniture into the floor (m)
 
 # Room geometry (metres).
@@ -461,9 +466,12 @@ def laptop_polys(x0, y0, z0, angle_deg=105.0):
 # The two rooms.
 
 
-def build(seed=1, converted=False):
+def build(seed=1, converted=False, without=frozenset()):
     """All polygons of the scene, each tagged with the room shell or object it belongs to
-    (``converted``: the converted style of the module's docstring)."""
+    (``converted``: the converted style of the module's docstring, but its features named in
+    ``without``, :data:`FEATURES`)."""
+    contacts, luminaires, solids = (converted and f not in without
+                                    for f in ("contacts", "luminaires", "solids"))
     rng = random.Random(seed)
     rects, polys, feet = [], [], []
     z0, z1 = Z_RANGE
@@ -499,7 +507,7 @@ def build(seed=1, converted=False):
               ("lamp_a2", (1.2, 2.4), (-3.8, -3.5)), ("lamp_a2", (3.6, 4.8), (-3.8, -3.5)),
               ("lamp_b", (7.6, 8.8), (-2.7, -2.3))]
     for k, (name, (lx0, lx1), (lz0, lz1)) in enumerate(lights):
-        if converted:
+        if luminaires:
             if k < 2:  # a closed box: emitting bottom, metal housing lying on the ceiling
                 for r in box(lx0, lx1, HEIGHT - 0.06, HEIGHT, lz0, lz1, "metal", "light"):
                     if r.axis == 1 and r.sign < 0:
@@ -520,7 +528,7 @@ def build(seed=1, converted=False):
     # Room A furniture.
     def place(local, angle_deg, pivot):
         """A turned assembly: its polygons and footprints."""
-        p, f = Assembly(local, math.radians(angle_deg), pivot, converted).finish()
+        p, f = Assembly(local, math.radians(angle_deg), pivot, contacts).finish()
         polys.extend(p)
         feet.extend(f)
 
@@ -541,7 +549,7 @@ def build(seed=1, converted=False):
                     sign = -sign
             lo, hi = [r6(c) for c in lo], [r6(c) for c in hi]
             moved = Rect(r.axis, lo[r.axis], sign, lo[u], hi[u], lo[v], hi[v], r.material, r.tag)
-            if converted:
+            if contacts:
                 sink(moved)
             rects.append(moved)
 
@@ -590,12 +598,13 @@ def build(seed=1, converted=False):
         floor.holes.append(hole)
         polys.extend(tris)
 
-    if converted:
+    if solids:
         # A partition built as two overlapping boxes (their faces inside each other) and a
         # column through the floor and the ceiling: buried faces, as IFC solids leave them.
         rects += box(5.2, 5.32, -0.05, 2.0, -3.4, -2.2, "wall_plaster", "partition")
         rects += box(5.2, 5.32, -0.05, 2.0, -2.6, -1.6, "wall_plaster", "partition")
         rects += box(3.0, 3.3, -0.1, HEIGHT + 0.1, -0.6, -0.3, "wall_plaster", "column")
+    if contacts:
         for r in rects:
             r.openings = list(r.holes)
     else:
@@ -765,7 +774,17 @@ def main():
     ap.add_argument("--style", choices=("clean", "converted", "both"), default="clean",
                     help="clean (furnished-*.obj) or converted (converted-*.obj): see above")
     ap.add_argument("--seed", type=int, default=1, help="seed of the furniture's variations")
+    ap.add_argument("--without", action="append", default=[], choices=FEATURES,
+                    help="converted style: leave this feature out (repeatable); the files are "
+                    "then converted-VARIANT-no-FEATURE.obj")
     args = ap.parse_args()
+    if args.without and args.style != "converted":
+        ap.error("--without applies to --style converted")
+    if "contacts" in args.without and "solids" not in args.without:
+        ap.error("--without contacts needs --without solids too: the column stands where "
+                 "only uncut contacts leave the faces it meets alone")
+    without = frozenset(args.without)
+    suffix = "".join(f"-no-{f}" for f in FEATURES if f in without)
 
     args.out.mkdir(parents=True, exist_ok=True)
     for name, img in textures().items():
@@ -774,15 +793,15 @@ def main():
     styles = ("clean", "converted") if args.style == "both" else (args.style,)
     for style in styles:
         converted = style == "converted"
-        polys = build(args.seed, converted)
+        polys = build(args.seed, converted, without)
         every = CONVERTED_VARIANTS if converted else VARIANTS
         variants = every if args.variant == "all" else (args.variant,)
         for variant in variants:
             if variant not in every:
                 ap.error(f"--variant {variant} is not made in the {style} style")
-            faces = variant_faces(polys, variant, converted)
+            faces = variant_faces(polys, variant, converted and "triangles" not in without)
             stem = "converted" if converted else "furnished"
-            path = args.out / f"{stem}-{variant}.obj"
+            path = args.out / f"{stem}-{variant}{suffix}.obj"
             write_obj(path, faces, "furnished.mtl", f"converted {variant}" if converted else variant)
             print(f"{path}: {len(faces)} faces")
 
