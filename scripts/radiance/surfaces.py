@@ -10,7 +10,7 @@ polygons), so the area-weighted mean over the surface has neither a patch sample
 that of points spread at random over large faces (the luminaires' hot spots on the ceiling make
 that 5 % noisy at 1,500 points). The tool's patches of a material are those with its
 reflectance (``patches.csv`` carries no material name: untextured materials only, each with a
-reflectance of its own).
+reflectance of its own, to 3 significant places).
 
     .venv-radiance/bin/python scripts/radiance/surfaces.py out/furnished/converted-plain.obj \\
         --out out/surf/plain --material wall_plaster --material ceiling
@@ -69,7 +69,7 @@ def main() -> None:
         table, polys = read_patches(sdir / "patches.csv"), read_ply_faces(sdir / "patches.ply")
     else:
         table, polys, _, _ = solve(binary, args.model, args.out, args.solve_args.split())
-    rho = np.round(np.stack([table["rho_r"], table["rho_g"], table["rho_b"]], axis=1), 3)
+    rho = np.stack([table["rho_r"], table["rho_g"], table["rho_b"]], axis=1)
     b = np.stack([table["b_r"], table["b_g"], table["b_b"]], axis=1)
     e = np.stack([table["e_r"], table["e_g"], table["e_b"]], axis=1)
     tool_y = ((b - e) / np.where(rho > 0, rho, 1.0)) @ LUMA
@@ -79,8 +79,9 @@ def main() -> None:
     report = {"model": str(args.model), "points_per_patch": args.points, "materials": {}}
     t0 = time.perf_counter()
     for m in args.material:
-        want = np.round(np.asarray(model.materials[names.index(m)].rho), 3)
-        ids = np.where(np.all(rho == want, axis=1))[0]
+        # To 3 significant places, so that reflectances scaled down (a direct-only run) keep apart.
+        want = np.asarray(model.materials[names.index(m)].rho)
+        ids = np.where(np.all(np.isclose(rho, want, rtol=5e-4, atol=0.0), axis=1))[0]
         if len(ids) == 0:
             sys.exit(f"no patch has {m}'s reflectance {want.tolist()}")
         pts, nrm = points_for(polys, ids, args.points, args.seed)
