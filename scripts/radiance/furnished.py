@@ -70,9 +70,10 @@ VARIANTS = ("plain", "doubled", "inside-out")
 CONVERTED_VARIANTS = ("plain", "doubled", "inside-out", "mixed")
 # The converted style's features, each of which `--without` can leave out (to find which of
 # them a difference to Radiance comes with): furniture uncut where it touches, bottoms kept and
-# sunk into the floor; luminaires as boxes and hung panels; the partition of overlapping boxes
+# sunk into the floor; luminaires as boxes and hung panels (or either kind alone left flush:
+# boxes, panels); the partition of overlapping boxes
 # and the column through floor and ceiling; every polygon as fan triangles.
-FEATURES = ("contacts", "luminaires", "solids", "triangles")
+FEATURES = ("contacts", "luminaires", "boxes", "panels", "solids", "triangles")
 SINK = 0.01  # how far the converted style sinks furniture into the floor (m)
 
 # Room geometry (metres).
@@ -507,7 +508,10 @@ def build(seed=1, converted=False, without=frozenset()):
               ("lamp_a2", (1.2, 2.4), (-3.8, -3.5)), ("lamp_a2", (3.6, 4.8), (-3.8, -3.5)),
               ("lamp_b", (7.6, 8.8), (-2.7, -2.3))]
     for k, (name, (lx0, lx1), (lz0, lz1)) in enumerate(lights):
-        if luminaires:
+        # Which luminaire this is as exported (the boxes, the hung panels, the face under the
+        # ceiling); `--without boxes` or `--without panels` makes that kind flush again.
+        kind = "boxes" if k < 2 else "panels" if k < 4 else "luminaires"
+        if luminaires and kind not in without:
             if k < 2:  # a closed box: emitting bottom, metal housing lying on the ceiling
                 for r in box(lx0, lx1, HEIGHT - 0.06, HEIGHT, lz0, lz1, "metal", "light"):
                     if r.axis == 1 and r.sign < 0:
