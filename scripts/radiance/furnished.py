@@ -73,7 +73,7 @@ CONVERTED_VARIANTS = ("plain", "doubled", "inside-out", "mixed")
 # sunk into the floor; luminaires as boxes and hung panels (or either kind alone left flush:
 # boxes, panels); the partition of overlapping boxes
 # and the column through floor and ceiling; every polygon as fan triangles.
-FEATURES = ("contacts", "luminaires", "boxes", "panels", "solids", "triangles")
+FEATURES = ("contacts", "luminaires", "boxes", "panels", "panel-tops", "solids", "triangles")
 SINK = 0.01  # how far the converted style sinks furniture into the floor (m)
 
 # Room geometry (metres).
@@ -518,7 +518,10 @@ def build(seed=1, converted=False, without=frozenset()):
                         r.material = name
                     rects.append(r)
             elif k < 4:  # a thin panel hung 0.3 m down, every face of it emitting
-                rects += box(lx0, lx1, HEIGHT - 0.32, HEIGHT - 0.3, lz0, lz1, name, "light")
+                for r in box(lx0, lx1, HEIGHT - 0.32, HEIGHT - 0.3, lz0, lz1, name, "light"):
+                    if "panel-tops" in without and r.axis == 1 and r.sign > 0:
+                        r.material = "metal"  # `--without panel-tops`: a top that does not emit
+                    rects.append(r)
             else:  # one downward face just under the ceiling
                 rects.append(Rect(1, HEIGHT - 0.02, -1, lz0, lz1, lx0, lx1, name, "light"))
             continue
