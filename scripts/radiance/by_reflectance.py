@@ -23,18 +23,16 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+from check import tool_irradiance  # noqa: E402
 from common import LUMA, read_patches  # noqa: E402
 
 
 def by_reflectance(path: Path) -> dict[tuple, tuple[float, float]]:
     """{rho (3 places): (sum of area x luminance-weighted irradiance, area)}."""
     t = read_patches(path)
-    rho = np.stack([t["rho_r"], t["rho_g"], t["rho_b"]], axis=1)
-    b = np.stack([t["b_r"], t["b_g"], t["b_b"]], axis=1)
-    e = np.stack([t["e_r"], t["e_g"], t["e_b"]], axis=1)
+    h, _, _, rho = tool_irradiance(t)
     keep = rho.min(axis=1) > 0
-    irr = (b[keep] - e[keep]) / rho[keep]
-    y = irr @ np.asarray(LUMA)
+    y = h[keep] @ LUMA
     area = t["area"][keep]
     out: dict[tuple, list[float]] = {}
     for r, yy, a in zip(np.round(rho[keep], 3), y, area):

@@ -32,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import objrad  # noqa: E402
-from check import Radiance, points_for, read_ply_faces, solve  # noqa: E402
+from check import Radiance, points_for, read_ply_faces, solve, tool_irradiance  # noqa: E402
 from common import BINARY_HELP, LUMA, radiosity_binary, read_patches  # noqa: E402
 
 
@@ -69,10 +69,8 @@ def main() -> None:
         table, polys = read_patches(sdir / "patches.csv"), read_ply_faces(sdir / "patches.ply")
     else:
         table, polys, _, _ = solve(binary, args.model, args.out, args.solve_args.split())
-    rho = np.stack([table["rho_r"], table["rho_g"], table["rho_b"]], axis=1)
-    b = np.stack([table["b_r"], table["b_g"], table["b_b"]], axis=1)
-    e = np.stack([table["e_r"], table["e_g"], table["e_b"]], axis=1)
-    tool_y = ((b - e) / np.where(rho > 0, rho, 1.0)) @ LUMA
+    h, _, _, rho = tool_irradiance(table)
+    tool_y = h @ LUMA
 
     radiance = Radiance(args, args.out)
     octree = radiance.octree(model, "scene")
