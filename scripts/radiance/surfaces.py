@@ -51,6 +51,9 @@ def main() -> None:
     ap.add_argument("--ad", type=int, default=128, help="rtrace -ad (default 128: the mean is "
                     "over thousands of points)")
     ap.add_argument("--lw", type=float, default=1e-4, help="rtrace -lw (default 1e-4)")
+    ap.add_argument("--within", type=float, nargs=6, metavar=("X0", "X1", "Y0", "Y1", "Z0", "Z1"),
+                    help="only the patches whose centre lies in this box (e.g. a surface's hot "
+                    "spots, with many --points)")
     ap.add_argument("--reuse", action="store_true",
                     help="take DIR/solve's patches.csv and patches.ply from an earlier run")
     ap.add_argument("--procs", type=int, default=os.cpu_count() or 1)
@@ -82,6 +85,13 @@ def main() -> None:
         ids = np.where(np.all(np.isclose(rho, want, rtol=5e-4, atol=0.0), axis=1))[0]
         if len(ids) == 0:
             sys.exit(f"no patch has {m}'s reflectance {want.tolist()}")
+        if args.within:
+            x0, x1, y0, y1, z0, z1 = args.within
+            c = [table[k][ids] for k in ("cx", "cy", "cz")]
+            ids = ids[(c[0] >= x0) & (c[0] <= x1) & (c[1] >= y0) & (c[1] <= y1) & (c[2] >= z0)
+                      & (c[2] <= z1)]
+            if len(ids) == 0:
+                sys.exit(f"no patch of {m} has its centre in the box {args.within}")
         pts, nrm = points_for(polys, ids, args.points, args.seed)
         y = (radiance.irradiance(octree, pts, nrm) @ LUMA).reshape(len(ids), args.points)
         rad = y.mean(axis=1)

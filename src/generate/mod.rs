@@ -27,7 +27,8 @@
 //! absolute indices from a running counter. Nothing but the plan (O(rooms per floor)) is kept.
 //! The same code runs without a writer to count patches, which is how
 //! [`BuildingOptions::for_patches`] picks a size: the count mimics [`crate::mesh`] (a quad cut
-//! into ⌈u/s⌉·⌈v/s⌉ cells, a triangle into k² with k = ⌈longest edge/s⌉, lengths in `f32`).
+//! into ⌈u/s⌉·⌈v/s⌉ cells, a triangle into k² with k = ⌈longest edge/s⌉, lengths in `f32`);
+//! the mesher's finer cuts near lights are measured on two storeys ([`near_light_factor`]).
 
 mod faces;
 mod geom;
@@ -72,8 +73,13 @@ pub struct BuildingOptions {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BuildingStats {
     pub polygons: u64,
-    /// Patches at [`BUILDING_PATCH_SIZE`], counted as the mesher cuts them.
+    /// Patches at [`BUILDING_PATCH_SIZE`] as the mesher cuts them: [`Self::uniform_patches`]
+    /// times the share the cuts near lights add, measured on two storeys
+    /// ([`near_light_factor`]).
     pub estimated_patches: u64,
+    /// Patches at [`BUILDING_PATCH_SIZE`] before the mesher cuts any finer near a light,
+    /// counted exactly as it cuts them.
+    pub uniform_patches: u64,
     /// Light fixtures (each one emitting polygon).
     pub lights: u64,
     /// Axis-aligned share of the area.
@@ -99,9 +105,22 @@ impl BuildingOptions {
     /// whole rooms are too coarse a step (one room: ~1,100, two: ~2,200): when the nearest
     /// count misses by more than [`FIT_TOLERANCE`], the room widths are stretched or shrunk
     /// ([`BuildingOptions::width_percent`], bisection on dry runs) for that number of rooms
-    /// and the one below. Every target from 1,000 to 2,000,000 lands within a few per cent.
+    /// and the one below. The count is the uniform cut's; the share the mesher adds near
+    /// lights is then measured on two storeys ([`near_light_factor`]) and the building fitted
+    /// again to the target over it. Every target from 1,000 to 2,000,000 lands within a few
+    /// per cent.
     pub fn for_patches(target: usize, seed: u64) -> BuildingOptions {
-        let floors = ((target as f64 / 2500.0).sqrt().round() as u32).clamp(1, 40);
+        let first = Self::fit_uniform(target as f64, seed);
+        let factor = near_light_factor(&first);
+        if (factor - 1.0).abs() <= FIT_TOLERANCE {
+            return first;
+        }
+        Self::fit_uniform(target as f64 / factor, seed)
+    }
+
+    /// The building whose uniform patch count is nearest `target` (see [`Self::for_patches`]).
+    fn fit_uniform(target: f64, seed: u64) -> BuildingOptions {
+        let floors = ((target / 2500.0).sqrt().round() as u32).clamp(1, 40);
         let opts = |rooms: u32, width_percent: u32| BuildingOptions {
             floors,
             rooms_per_floor: rooms.max(1),
@@ -109,9 +128,8 @@ impl BuildingOptions {
             width_percent,
         };
         let count = |o: &BuildingOptions| -> f64 {
-            build(None, None, "", o).map_or(f64::INFINITY, |s| s.estimated_patches as f64)
+            build(None, None, "", o).map_or(f64::INFINITY, |s| s.uniform_patches as f64)
         };
-        let target = target as f64;
         let rooms = nearest_rooms(target, |r| count(&opts(r, 100)));
         let mut best = (opts(rooms, 100), (count(&opts(rooms, 100)) - target).abs());
         if best.1 <= FIT_TOLERANCE * target {
@@ -189,7 +207,41 @@ pub fn write_building(
     mtl_name: &str,
     opts: &BuildingOptions,
 ) -> io::Result<BuildingStats> {
-    build(Some(obj), Some(mtl), mtl_name, opts)
+    let mut stats = build(Some(obj), Some(mtl), mtl_name, opts)?;
+    stats.estimated_patches =
+        (stats.uniform_patches as f64 * near_light_factor(opts)).round() as u64;
+    Ok(stats)
+}
+
+/// How many times the uniform cut's patches the mesher makes of this building, with its cuts
+/// near lights (`mesh::near_lights`): measured by meshing at most two storeys of it (the same
+/// rooms, widths and seed; two, so the stair room is in) in memory. Every storey above the first
+/// has the same plan and lights, so the share is the building's to about a per cent; 1 when the
+/// storeys cannot be made.
+pub fn near_light_factor(opts: &BuildingOptions) -> f64 {
+    let storey = BuildingOptions {
+        floors: opts.floors.min(2),
+        ..opts.clone()
+    };
+    let (mut obj, mut mtl) = (Vec::new(), Vec::new());
+    let Ok(stats) = build(Some(&mut obj), Some(&mut mtl), "building.mtl", &storey) else {
+        return 1.0;
+    };
+    let (Ok(obj), Ok(mtl)) = (String::from_utf8(obj), String::from_utf8(mtl)) else {
+        return 1.0;
+    };
+    let load = crate::scene::LoadOptions::default();
+    let Ok(scene) = crate::scene::load_obj_from_strs("building.obj", &obj, &mtl, &load) else {
+        return 1.0;
+    };
+    let mesh = crate::mesh::build(
+        &scene,
+        &crate::mesh::MeshOptions {
+            patch_size: Some(BUILDING_PATCH_SIZE),
+            ..Default::default()
+        },
+    );
+    mesh.patches.len() as f64 / stats.uniform_patches.max(1) as f64
 }
 
 /// Writes the building to the file `out` and its MTL beside it (same stem, `.mtl`), each
@@ -329,6 +381,7 @@ fn build(
     Ok(BuildingStats {
         polygons: out.polygons,
         estimated_patches: out.patches,
+        uniform_patches: out.patches,
         lights: out.lights,
         axial_fraction: out.axial / (out.axial + out.skew).max(f64::MIN_POSITIVE),
     })
@@ -413,7 +466,15 @@ mod tests {
         let (mut obj, mut mtl) = (Vec::new(), Vec::new());
         let written = write_building(&mut obj, &mut mtl, "b.mtl", &opts).unwrap();
         let counted = build(None, None, "", &opts).unwrap();
-        assert_eq!(written, counted);
+        // A dry run counts the uniform cut; the file's stats add the cuts near lights.
+        assert_eq!(
+            BuildingStats {
+                estimated_patches: written.uniform_patches,
+                ..written.clone()
+            },
+            counted
+        );
+        assert!(written.estimated_patches > written.uniform_patches);
         let text = String::from_utf8(obj).unwrap();
         assert_eq!(
             text.lines().filter(|l| l.starts_with("f ")).count() as u64,

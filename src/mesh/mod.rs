@@ -19,9 +19,11 @@
 //! | `sides.rs`     | sides and back twins (docs/design.md §7)       |
 //! | `hidden.rs`    | the sides no light can reach (what was found)  |
 //! | `contact.rs`   | faces lying on faces that face them            |
+//! | `near_lights.rs` | patches cut finer where a light is close     |
 
 mod contact;
 mod hidden;
+mod near_lights;
 pub use contact::Contacts;
 pub use hidden::Hidden;
 mod classify;
@@ -143,6 +145,9 @@ pub struct MeshOptions {
     /// says, instead of giving the faces lit from behind back patches of their own
     /// (`pipeline::stages::lit_backs`, the default).
     pub one_sided: bool,
+    /// Cut every patch to the patch size only, not finer near lights (`near_lights.rs`): for
+    /// tests and studies that want one patch per face.
+    pub uniform_patches: bool,
 }
 
 impl MeshOptions {
@@ -260,8 +265,12 @@ pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
     let size = patch_size(scene, opts);
     let (lo, hi) = scene.bounds();
     let mut b = Builder::new(size, (hi - lo).length().max(f32::MIN_POSITIVE));
+    if !opts.uniform_patches {
+        b.near = near_lights::NearLights::new(scene, size);
+    }
     for (pi, poly) in scene.polygons.iter().enumerate() {
         let pts = polygon_points(scene, poly);
+        b.refine_near = !scene.materials[poly.material as usize].is_emitter();
         let back = back_material(scene, poly, opts);
         for piece in planar_convex_pieces(&pts) {
             let start = b.mesh.patches.len();

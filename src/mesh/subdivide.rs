@@ -4,6 +4,7 @@
 //! area centroid, normal and class.
 
 use super::classify::classify;
+use super::near_lights::{NearLights, NEAR_LIGHT_CUTS};
 use super::{newell, Mesh, Patch, Side};
 use glam::Vec3;
 use std::collections::HashMap;
@@ -15,6 +16,10 @@ pub(super) struct Builder {
     /// Weld grid cell size: positions closer than this (and facing the same way) are one vertex.
     pub(super) quantum: f32,
     pub(super) weld: HashMap<([i64; 3], [i32; 3], u32), u32>,
+    /// The scene's lights, to cut patches near them finer (`near_lights.rs`).
+    pub(super) near: Option<NearLights>,
+    /// Whether the polygon being added is refined near lights (not a light itself).
+    pub(super) refine_near: bool,
 }
 
 impl Builder {
@@ -27,6 +32,8 @@ impl Builder {
             size,
             quantum: diagonal * 1e-6,
             weld: HashMap::new(),
+            near: None,
+            refine_near: false,
         }
     }
 
@@ -54,9 +61,9 @@ impl Builder {
                 // so every cell is a planar convex quad with edges ≤ the patch size.
                 let at = |i: usize, j: usize| {
                     let (u, v) = (i as f32 / m as f32, j as f32 / k as f32);
-                    let a = pts[0].lerp(pts[1], u);
-                    let b = pts[3].lerp(pts[2], u);
-                    a.lerp(b, v)
+                    let a = along(pts[0], pts[1], u);
+                    let b = along(pts[3], pts[2], u);
+                    along(a, b, v)
                 };
                 let grid: Vec<u32> = (0..=k)
                     .flat_map(|j| (0..=m).map(move |i| (i, j)))
@@ -106,8 +113,14 @@ impl Builder {
         polygon: u32,
     ) {
         let at = |i: usize, j: usize| {
-            // Point i steps along t0→t1 and j steps along t0→t2.
-            t[0] + (t[1] - t[0]) * (i as f32 / k as f32) + (t[2] - t[0]) * (j as f32 / k as f32)
+            // Point i steps along t0→t1 and j steps along t0→t2; on the edges, along them
+            // (exactly on an axis-aligned edge's line, see `along`).
+            let (a, b) = (i as f32 / k as f32, j as f32 / k as f32);
+            if i + j == k {
+                along(t[1], t[2], b)
+            } else {
+                t[0] + (t[1] - t[0]) * a + (t[2] - t[0]) * b
+            }
         };
         let mut row_start = Vec::with_capacity(k + 1);
         let mut ids = Vec::new();
@@ -141,6 +154,51 @@ impl Builder {
     }
 
     fn push_patch(&mut self, ids: &[u32], n: Vec3, material: u32, polygon: u32) {
+        self.push_near_cut(ids, n, material, polygon, 0);
+    }
+
+    /// A patch, cut in four (quads and triangles by their edges' midpoints, other polygons
+    /// fanned from their centre) for as long as a light is too near it (`near_lights.rs`).
+    fn push_near_cut(&mut self, ids: &[u32], n: Vec3, material: u32, polygon: u32, depth: u32) {
+        let pts: Vec<Vec3> = ids
+            .iter()
+            .map(|&i| self.mesh.vertices[i as usize])
+            .collect();
+        let cut = self.refine_near
+            && depth < NEAR_LIGHT_CUTS
+            && self.near.as_ref().is_some_and(|l| l.too_near(&pts, n));
+        if !cut {
+            return self.push_final(ids, n, material, polygon);
+        }
+        let count = pts.len();
+        let mid: Vec<u32> = (0..count)
+            .map(|k| self.vertex(along(pts[k], pts[(k + 1) % count], 0.5), n, material))
+            .collect();
+        let cells: Vec<Vec<u32>> = match count {
+            3 => vec![
+                vec![ids[0], mid[0], mid[2]],
+                vec![mid[0], ids[1], mid[1]],
+                vec![mid[2], mid[1], ids[2]],
+                vec![mid[0], mid[1], mid[2]],
+            ],
+            _ => {
+                // Quads into four quads; an n-gon into n quads about its centre (both convex).
+                let c = self.vertex(
+                    pts.iter().copied().sum::<Vec3>() / count as f32,
+                    n,
+                    material,
+                );
+                (0..count)
+                    .map(|k| vec![ids[k], mid[k], c, mid[(k + count - 1) % count]])
+                    .collect()
+            }
+        };
+        for cell in cells {
+            self.push_near_cut(&cell, n, material, polygon, depth + 1);
+        }
+    }
+
+    fn push_final(&mut self, ids: &[u32], n: Vec3, material: u32, polygon: u32) {
         let pts: Vec<Vec3> = ids
             .iter()
             .map(|&i| self.mesh.vertices[i as usize])
@@ -177,5 +235,18 @@ impl Builder {
             class: classify(&pts, n),
             side: Side::One,
         });
+    }
+}
+
+/// The point a fraction `s` of the way from `a` to `b`: a + (b − a)·s, and `b` itself at
+/// s = 1. Exact in every coordinate where `a` and `b` agree, so a cut point of an axis-aligned
+/// edge lies on the edge's line, where the neighbour across it has its own vertices: glam's
+/// `lerp`, a·(1 − s) + b·s, can put it an ulp off that line and open a crack a ray slips
+/// through.
+fn along(a: Vec3, b: Vec3, s: f32) -> Vec3 {
+    if s >= 1.0 {
+        b
+    } else {
+        a + (b - a) * s
     }
 }

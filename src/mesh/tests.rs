@@ -42,6 +42,7 @@ fn opts(size: f32) -> MeshOptions {
         patch_size: Some(size),
         two_sided: false,
         one_sided: false,
+        uniform_patches: false,
     }
 }
 
@@ -139,6 +140,7 @@ fn two_sided_adds_opposite_patches_with_their_own_vertices() {
             patch_size: Some(0.5),
             two_sided: true,
             one_sided: false,
+            uniform_patches: false,
         },
     );
     assert_eq!(m.patches.len(), 8);
@@ -199,6 +201,7 @@ fn an_emitter_stays_one_sided_and_a_merged_back_material_is_used() {
         patch_size: Some(1.0),
         two_sided: true,
         one_sided: false,
+        uniform_patches: false,
     };
     let m = build(&s, &two);
     assert_eq!(m.patches.len(), 3, "lamp one-sided, the other two-sided");

@@ -24,6 +24,7 @@ fn office() -> (Scene, Mesh) {
             patch_size: Some(0.6),
             two_sided: false,
             one_sided: false,
+            uniform_patches: false,
         },
     );
     (s, m)

@@ -24,6 +24,7 @@ fn the_references_bound_holds_against_an_independent_reference() {
             patch_size: Some(0.1),
             two_sided: false,
             one_sided: false,
+            uniform_patches: false,
         },
     );
     let isect = EmbreeScene::build(&m, |_| true).unwrap();

@@ -36,6 +36,7 @@ fn mesh(s: &Scene, two_sided: bool) -> Mesh {
             patch_size: Some(1.0),
             two_sided,
             one_sided: false,
+            uniform_patches: false,
         },
     )
 }

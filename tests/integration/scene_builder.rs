@@ -139,6 +139,20 @@ pub fn mesh_at(scene: &Scene, patch_size: Option<f32>) -> Mesh {
             patch_size,
             two_sided: false,
             one_sided: false,
+            uniform_patches: false,
+        },
+    )
+}
+
+/// As [`mesh_at`], one patch per face where the patch size allows: no cuts near lights (for
+/// tests that count patches or read one face's form factor).
+pub fn mesh_uniform(scene: &Scene, patch_size: Option<f32>) -> Mesh {
+    radiosity::mesh::build(
+        scene,
+        &MeshOptions {
+            patch_size,
+            uniform_patches: true,
+            ..MeshOptions::default()
         },
     )
 }

@@ -58,6 +58,21 @@ fn documented(file: &str) -> Documented {
     }
 }
 
+const SEAM_MARK: &str = "seams: ";
+
+/// Whether a ray that met nothing meets the front of a patch once turned by 10⁻⁵ rad each way
+/// about two axes across it: it slipped through a seam, not a hole.
+fn seam(isect: &EmbreeScene, ray: &Ray) -> bool {
+    let (u, w) = ray.dir.any_orthonormal_pair();
+    [u, -u, w, -w].iter().all(|&t| {
+        let turned = Ray {
+            dir: (ray.dir + t * 1e-5).normalize(),
+            ..*ray
+        };
+        isect.intersect(&turned).is_some_and(|h| !h.back)
+    })
+}
+
 /// A uniform random point of patch `i` (a convex polygon, fanned from its first vertex).
 fn point_on_patch(mesh: &Mesh, i: usize, rng: &mut Pcg64Mcg) -> Vec3 {
     let ids = mesh.patch_indices(i);
@@ -104,6 +119,7 @@ fn assert_closed(what: &str, mesh: &Mesh, rays: usize, seed: u64) {
             set_flush_denormals();
             let mut rng = Pcg64Mcg::seed_from_u64(seed ^ (c as u64).wrapping_mul(0x9E37_79B9));
             let mut bad = Vec::new();
+            let mut seams = 0usize;
             for _ in 0..per_chunk {
                 let i = rng.gen_range(0..mesh.patches.len());
                 let p = &mesh.patches[i];
@@ -124,6 +140,11 @@ fn assert_closed(what: &str, mesh: &Mesh, rays: usize, seed: u64) {
                     tfar: f32::INFINITY,
                 };
                 match isect.intersect(&ray) {
+                    // A ray that meets a seam exactly where two faces' collinear edges end at
+                    // different points (a T-junction: the floor of one polygon beside another's)
+                    // may slip between them in floating point, as in any ray tracer; turned by
+                    // 10⁻⁵ rad either way it hits. A real hole lets the turned rays out too.
+                    None if seam(&isect, &ray) => seams += 1,
                     None => bad.push(format!("escaped from patch {i} at {org} along {dir}")),
                     Some(h) if h.back => bad.push(format!(
                         "back of patch {} from patch {i} at {org} along {dir} (t {})",
@@ -132,9 +153,23 @@ fn assert_closed(what: &str, mesh: &Mesh, rays: usize, seed: u64) {
                     Some(_) => {}
                 }
             }
+            if seams > 0 {
+                bad.push(format!("{SEAM_MARK}{seams}"));
+            }
             bad
         })
         .collect();
+    let (seams, failures): (Vec<String>, Vec<String>) =
+        (failures.into_iter()).partition(|f| f.starts_with(SEAM_MARK));
+    let seams: usize = (seams.iter())
+        .map(|f| f[SEAM_MARK.len()..].parse::<usize>().unwrap())
+        .sum();
+    // At most one ray in 10⁴ on a seam (measured: 1 in 10⁵ on a generated building).
+    assert!(
+        seams * 10_000 <= chunks * per_chunk,
+        "{what}: {seams} of {} rays slipped through seams",
+        chunks * per_chunk
+    );
     assert!(
         failures.is_empty(),
         "{what}: {} of {} rays failed, e.g. {:?}",
@@ -254,10 +289,27 @@ fn generated_buildings_are_closed_and_sized_as_asked() {
             (n as f64 - target as f64).abs() <= 0.2 * target as f64,
             "asked for {target} patches, got {n} ({opts:?})"
         );
-        // The generator counts patches as the mesher cuts them, in the same f32 arithmetic;
-        // only a coordinate rounded differently on its way through the text could differ.
+        // The generator counts patches as the mesher cuts them uniformly, in the same f32
+        // arithmetic; only a coordinate rounded differently on its way through the text could
+        // differ.
+        let uniform = radiosity::mesh::build(
+            &scene,
+            &MeshOptions {
+                patch_size: Some(BUILDING_PATCH_SIZE),
+                uniform_patches: true,
+                ..MeshOptions::default()
+            },
+        )
+        .patches
+        .len();
         assert!(
-            (n as f64 - stats.estimated_patches as f64).abs() <= 0.02 * n as f64,
+            (uniform as f64 - stats.uniform_patches as f64).abs() <= 0.02 * uniform as f64,
+            "counted {} patches of the uniform cut, meshed {uniform}",
+            stats.uniform_patches
+        );
+        // The cuts near lights, measured on two storeys, stand for every storey's.
+        assert!(
+            (n as f64 - stats.estimated_patches as f64).abs() <= 0.05 * n as f64,
             "estimated {} patches, meshed {n}",
             stats.estimated_patches
         );

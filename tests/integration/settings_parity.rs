@@ -334,6 +334,7 @@ const SHAPING: &[Shaping] = &[
     shaping("patch-size", &["--patch-size", "0.5"], &[]),
     shaping("two-sided", &["--two-sided"], &[]),
     shaping("one-sided", &["--one-sided"], &[]),
+    shaping("uniform-patches", &["--uniform-patches"], &[]),
     shaping("flip", &["--flip"], &[]),
     shaping("seed", &["--seed", "7"], &[]),
     shaping("tolerance", &["--tolerance", "0.1"], &[]),

@@ -37,6 +37,11 @@ pub struct SceneArgs {
     /// back patches of their own, found by a quick first shooting.
     #[arg(long)]
     pub one_sided: bool,
+    /// Cut patches to the patch size only. By default a patch is cut finer (to 1/8 of the size
+    /// at most) where a light close to it bends its light across it by more than the scene's
+    /// mean irradiance: a hot spot under a hung panel is not averaged away.
+    #[arg(long)]
+    pub uniform_patches: bool,
     /// Turn every polygon round: for models wound clockwise (rooms inside out, lights facing
     /// away from them).
     #[arg(long)]
@@ -55,6 +60,7 @@ impl SceneArgs {
             patch_size: self.patch_size,
             two_sided: self.two_sided,
             one_sided: self.one_sided,
+            uniform_patches: self.uniform_patches,
         }
     }
 }
