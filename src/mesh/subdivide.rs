@@ -160,13 +160,14 @@ impl Builder {
     /// A patch, cut in four (quads and triangles by their edges' midpoints, other polygons
     /// fanned from their centre) for as long as a light is too near it (`near_lights.rs`).
     fn push_near_cut(&mut self, ids: &[u32], n: Vec3, material: u32, polygon: u32, depth: u32) {
+        if !(self.refine_near && depth < NEAR_LIGHT_CUTS && self.near.is_some()) {
+            return self.push_final(ids, n, material, polygon);
+        }
         let pts: Vec<Vec3> = ids
             .iter()
             .map(|&i| self.mesh.vertices[i as usize])
             .collect();
-        let cut = self.refine_near
-            && depth < NEAR_LIGHT_CUTS
-            && self.near.as_ref().is_some_and(|l| l.too_near(&pts, n));
+        let cut = self.near.as_ref().is_some_and(|l| l.too_near(&pts, n));
         if !cut {
             return self.push_final(ids, n, material, polygon);
         }
