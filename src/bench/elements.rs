@@ -14,7 +14,7 @@
 //! count (uniform interpolated between depths, log–log), and the uniform count that matches
 //! the adaptive error.
 
-use crate::elements::{self, Elements, Rule, Test};
+use crate::elements::{self, CornerLight, Corners, Elements, Rule, Test};
 use crate::intersect::select::IntersectorKind;
 use crate::light::LightAt;
 use crate::model::Model;
@@ -35,9 +35,29 @@ pub struct ElementBenchJob {
     pub floor: f64,
     /// Smallest element edge (metres); `None`: the patch size / 8.
     pub min_size: Option<f32>,
-    /// Rays per corner of the uniform and adaptive meshes, and of the reference.
+    /// Rays per corner of the uniform and adaptive meshes, and what they gather; the
+    /// reference gathers the whole light ([`CornerLight::Full`]) with `reference_rays`.
     pub rays: usize,
+    pub light: CornerLight,
     pub reference_rays: usize,
+}
+
+impl ElementBenchJob {
+    /// What the corners of the uniform and adaptive meshes gather.
+    fn corners(&self) -> Corners {
+        Corners {
+            rays: self.rays,
+            light: self.light,
+        }
+    }
+
+    /// What the reference's corners gather: the whole light at `reference_rays`.
+    fn reference_corners(&self) -> Corners {
+        Corners {
+            rays: self.reference_rays,
+            light: CornerLight::Full,
+        }
+    }
 }
 
 /// `radiosity bench elements --thresholds`: the adaptive meshes' thresholds.
@@ -193,19 +213,22 @@ pub fn run(
         m.patches.len(),
         job.reference_rays
     ));
-    // Every patch cut to `depth`, `rays` per corner.
-    let uniform = |depth: u32, rays: usize| {
+    // Every patch refined by `rule`, its corners gathered as `corners` says.
+    let refine = |rule: Rule, corners: Corners| {
         elements::refine_by(
             m,
             &gather,
-            Rule::Uniform(depth),
-            rays,
+            &sol.b,
+            rule,
+            corners,
             usize::MAX,
             seed,
             Default::default(),
         )
     };
-    let (reference, rs) = uniform(ref_depth, job.reference_rays);
+    let uniform = |depth: u32, corners: Corners| refine(Rule::Uniform(depth), corners);
+    let corners = job.corners();
+    let (reference, rs) = uniform(ref_depth, job.reference_corners());
     log(&format!(
         "reference: {} elements, {} rays, {:.1} s",
         rs.count, rs.rays, rs.seconds
@@ -214,7 +237,7 @@ pub fn run(
     let unlit = UNLIT * elements::mean_radiosity(m, &sol.b);
     let mut rows = Vec::new();
     for d in 0..=depth {
-        let (el, st) = uniform(d, job.rays);
+        let (el, st) = uniform(d, corners);
         let (error, energy_error) = error_against(model, &reference, &el, unlit);
         log(&format!(
             "uniform depth {d}: {} elements, error {:.2} % (energy {:.2} %), {:.2} s",
@@ -245,15 +268,7 @@ pub fn run(
             min_size,
             test,
         };
-        let (el, st) = elements::refine_by(
-            m,
-            &gather,
-            rule,
-            job.rays,
-            usize::MAX,
-            seed,
-            Default::default(),
-        );
+        let (el, st) = refine(rule, corners);
         let (error, energy_error) = error_against(model, &reference, &el, unlit);
         log(&format!(
             "adaptive {test:?} threshold {threshold}: {} elements, error {:.2} % (energy {:.2} %), {:.2} s",

@@ -16,11 +16,10 @@
 //! changes is within it too.
 
 use super::geometry::Elem;
-use super::refine::{key, PatchWork, Refiner};
+use super::refine::{facing, key, PatchWork, Refiner};
 use crate::intersect::Intersector;
 use crate::mesh::{newell, Mesh, Patch, Side};
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// The element mesh and what it holds per element and per vertex.
@@ -36,19 +35,10 @@ pub(super) struct Built {
 
 type WeldKey = ([i64; 3], [i32; 3], u32);
 
-/// Gathers every kept element's corners (those the refinement did not need yet), welds them
-/// and builds the mesh.
-pub(super) fn build<I: Intersector>(r: &Refiner<'_, I>, mut work: Vec<PatchWork>) -> Built {
+/// Welds the kept elements' corners (their values gathered by [`super::refine::finish`]) and
+/// builds the mesh.
+pub(super) fn build<I: Intersector>(r: &Refiner<'_, I>, work: Vec<PatchWork>, rays: u64) -> Built {
     let mesh = r.mesh;
-    // The last level's corners, per patch in parallel.
-    work.par_iter_mut().enumerate().for_each(|(i, w)| {
-        let done = std::mem::take(&mut w.done);
-        for e in &done {
-            r.values(i, e, w);
-        }
-        w.done = done;
-    });
-    let rays = work.iter().map(|w| w.rays).sum();
     let mut out = Mesh {
         patch_size: mesh.patch_size,
         ..Mesh::default()
@@ -60,9 +50,9 @@ pub(super) fn build<I: Intersector>(r: &Refiner<'_, I>, mut work: Vec<PatchWork>
     let mut elems = Vec::new();
     for (i, w) in work.iter().enumerate() {
         let p = &mesh.patches[i];
-        let qn = |x: f32| (x * 1000.0).round() as i32;
-        let facing = [qn(p.normal.x), qn(p.normal.y), qn(p.normal.z)];
+        let facing = facing(p.normal);
         let mut counted = std::collections::HashSet::new();
+        let mut values = w.corner_b.iter();
         for e in &w.done {
             let pts = e.corners(&w.roots);
             let mut ids = Vec::with_capacity(pts.len());
@@ -76,8 +66,8 @@ pub(super) fn build<I: Intersector>(r: &Refiner<'_, I>, mut work: Vec<PatchWork>
                     count.push(0);
                 }
                 // A corner gathered by several patches takes the mean of their values.
+                let v = values.next().copied().unwrap_or([0.0; 3]);
                 if counted.insert(id) {
-                    let v = w.cache.get(&key(q, r.quantum)).copied().unwrap_or([0.0; 3]);
                     for c in 0..3 {
                         sum[id as usize][c] += v[c];
                     }
@@ -140,7 +130,6 @@ fn push_element(out: &mut Mesh, ids: &[u32], pts: &[DVec3], p: &Patch) {
 /// Makes the shading conform across T-junctions (module docs): every element edge, longest
 /// first, gives each welded vertex at its midpoint (recursively) the mean of its ends.
 fn conform(m: &Mesh, weld: &HashMap<WeldKey, u32>, quantum: f64, vb: &mut [[f64; 3]]) {
-    let qn = |x: f32| (x * 1000.0).round() as i32;
     let mut edges: Vec<(f64, u32, u32, usize)> = Vec::new();
     for e in 0..m.patches.len() {
         let ids = m.patch_indices(e);
@@ -160,7 +149,7 @@ fn conform(m: &Mesh, weld: &HashMap<WeldKey, u32>, quantum: f64, vb: &mut [[f64;
     edges.dedup_by(|x, y| x.1 == y.1 && x.2 == y.2);
     for &(_, a, b, e) in &edges {
         let p = &m.patches[e];
-        let facing = [qn(p.normal.x), qn(p.normal.y), qn(p.normal.z)];
+        let facing = facing(p.normal);
         let mut stack = vec![(a, b, 0u32)];
         while let Some((a, b, depth)) = stack.pop() {
             if depth > 12 {

@@ -34,7 +34,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
-pub use refine::{Rule, Stop, Test};
+pub use refine::{CornerLight, Rule, Stop, Test};
 
 /// Default `--element-threshold` ([`Test::Halves`]): an element is cut while the error of
 /// its interpolation, relative to its mean and weighed by its share of its patch, exceeds
@@ -79,6 +79,8 @@ pub struct ElementSettings {
     pub max_factor: f64,
     /// What the threshold is applied to (`--element-test`).
     pub test: Test,
+    /// What is gathered at the corners (`--element-light`).
+    pub light: CornerLight,
 }
 
 impl Default for ElementSettings {
@@ -91,6 +93,7 @@ impl Default for ElementSettings {
             rays: DEFAULT_RAYS,
             max_factor: DEFAULT_MAX_FACTOR,
             test: Test::Halves,
+            light: CornerLight::Full,
         }
     }
 }
@@ -147,7 +150,8 @@ pub struct ElementStats {
     pub patches: u64,
     /// Welded element vertices.
     pub vertices: u64,
-    /// Corners gathered (a corner shared by patches is gathered by each).
+    /// Points gathered: the corners and the points the test reads (a point inside a surface
+    /// once for all its patches, a point on a room's edge by each patch that has it).
     pub gathered: u64,
     /// Rays cast by the corners' gathers.
     pub rays: u64,
@@ -308,23 +312,39 @@ pub fn refine_until<I: Intersector>(
         test: settings.test,
     };
     let cap = (settings.max_factor * mesh.patches.len() as f64).ceil() as usize;
-    let (el, mut stats) = refine_by(mesh, gather, rule, settings.rays, cap, seed, stop);
+    let corners = Corners {
+        rays: settings.rays,
+        light: settings.light,
+    };
+    let (el, mut stats) = refine_by(mesh, gather, b, rule, corners, cap, seed, stop);
     stats.threshold = settings.threshold;
     stats.min_size = min_size;
     (el, stats)
 }
 
-/// [`refine()`] by any [`Rule`] (the uniform meshing it is measured against), with `rays` per
-/// corner and at most `cap` elements, stopping early as `stop` says.
+/// What each corner gathers: `rays` rays of `light`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Corners {
+    pub rays: usize,
+    pub light: CornerLight,
+}
+
+/// [`refine()`] by any [`Rule`] (the uniform meshing it is measured against), with `corners`
+/// gathered as it says and at most `cap` elements, stopping early as `stop` says.
+// Eight: the mesh, its light and its solution, and the five choices of a refinement (what is
+// cut, what is gathered, the cap, the seed, what stops it), each of which the bench varies.
+#[allow(clippy::too_many_arguments)]
 pub fn refine_by<I: Intersector>(
     mesh: &Mesh,
     gather: &LightAt<'_, I>,
+    b: &[[f64; 3]],
     rule: Rule,
-    rays: usize,
+    corners: Corners,
     cap: usize,
     seed: u64,
     stop: Stop<'_>,
 ) -> (Elements, ElementStats) {
+    let Corners { rays, light } = corners;
     let t = Instant::now();
     let (lo, hi) = mesh.vertices.iter().fold(
         (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
@@ -334,14 +354,17 @@ pub fn refine_by<I: Intersector>(
     let r = refine::Refiner {
         mesh,
         gather,
+        b,
         seed,
         rays,
+        light,
         quantum: diagonal * 1e-6,
+        inner: refine::inner_edges(mesh),
         stop,
     };
-    let (work, capped) = refine::run(&r, rule, cap.max(mesh.patches.len()));
-    let gathered: usize = work.iter().map(|w| w.cache.len()).sum();
-    let built = display::build(&r, work);
+    let (work, values, capped) = refine::run(&r, rule, cap.max(mesh.patches.len()));
+    let gathered = values.map.len();
+    let built = display::build(&r, work, values.rays);
     let vertex_b: Vec<[f32; 3]> = built.vertex_b.iter().map(|v| v.map(|x| x as f32)).collect();
     let mut el = Elements::new(built.mesh, built.patch, vertex_b);
     el.params = built.elems;

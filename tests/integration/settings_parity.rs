@@ -367,6 +367,7 @@ const SHAPING: &[Shaping] = &[
     shaping("element-rays", &["--element-rays", "16"], &[]),
     shaping("element-max", &["--element-max", "16"], &[]),
     shaping("element-test", &["--element-test", "corners"], &[]),
+    shaping("element-light", &["--element-light", "direct"], &[]),
     shaping("per-light", &["--per-light"], &[]),
     shaping(
         "light-groups",
@@ -389,6 +390,7 @@ const NOT_IN_KEY: &[&str] = &[
     "element-rays",
     "element-max",
     "element-test",
+    "element-light",
 ];
 
 /// The flags of `solve` that do not shape the patch radiosities, and why.

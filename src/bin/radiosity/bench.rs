@@ -108,6 +108,10 @@ pub enum BenchCommand {
         /// Rays per corner of the uniform and adaptive meshes.
         #[arg(long, default_value_t = radiosity::elements::DEFAULT_RAYS)]
         element_rays: usize,
+        /// What the corners of the uniform and adaptive meshes gather (--element-light); the
+        /// reference's gather the whole light.
+        #[arg(long, value_enum, default_value_t = radiosity::elements::CornerLight::default())]
+        element_light: radiosity::elements::CornerLight,
         /// Rays per corner of the reference.
         #[arg(long, default_value_t = DEFAULT_REFERENCE_RAYS)]
         reference_rays: usize,
@@ -273,6 +277,7 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
             floor,
             element_min_size,
             element_rays,
+            element_light,
             reference_rays,
             out,
         } => {
@@ -283,6 +288,7 @@ pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
                 floor,
                 min_size: element_min_size,
                 rays: element_rays,
+                light: element_light,
                 reference_rays,
             };
             bench_elements(scene, scene_args, job, out)

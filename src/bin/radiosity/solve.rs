@@ -100,6 +100,12 @@ pub struct ElementArgs {
     /// between its corners, cut in four).
     #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().test)]
     element_test: elements::Test,
+    /// What each corner gathers: full (the whole light, direct and hemisphere rays) or
+    /// direct (the emitters' and the sun's light by shadow rays; the indirect light
+    /// interpolated from the patch solution: about a quarter of the rays, a preview that
+    /// misses the indirect light's contact shadows).
+    #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().light)]
+    element_light: elements::CornerLight,
 }
 
 /// `--elements`.
@@ -120,6 +126,7 @@ impl ElementArgs {
             rays: self.element_rays,
             max_factor: self.element_max,
             test: self.element_test,
+            light: self.element_light,
         }
     }
 }
