@@ -152,11 +152,19 @@ pub const LIT_BACKS_MIN: f64 = 1e-2;
 /// meets the remaining backs is below this share of the emitted light.
 pub const LIT_BACKS_LEFT: f64 = 2e-4;
 
+/// The first shooting of [`lit_backs`] samples at this tolerance at least.
+pub const LIT_BACKS_TOLERANCE: f64 = 0.15;
+/// ... and stops once less than this share of the emitted light is still unshot: where light
+/// meets backs is told by the light's first bounces, and the paper's stop (Sec. 3) would cost
+/// as many shots as the solve itself.
+pub const LIT_BACKS_UNSHOT: f64 = 0.05;
+
 /// Lit backs: unless the mesh is two-sided or `--one-sided` is asked for, a first shooting
-/// (no final gather, no error target, the tolerance at least 0.15: about a ninth of the rays)
-/// finds where light meets the back of a one-sided face — a model wound both ways, a room
-/// inside out — and the polygons lit so get back patches of their own (appended, so the
-/// intersector stays valid), as Radiance, whose surfaces are all two-sided, sees them. Rays
+/// (no final gather, no error target, the tolerance at least [`LIT_BACKS_TOLERANCE`], until
+/// [`LIT_BACKS_UNSHOT`] of the light is left) finds where light meets the back of a one-sided
+/// face — a model wound both ways, a room inside out — and the polygons lit so get back
+/// patches of their own (appended, so the intersector stays valid), as Radiance, whose
+/// surfaces are all two-sided, sees them. Rays
 /// that left a covered part of their shooter are not cast (`crate::mesh::Contacts`) or carry
 /// nothing (`crate::mesh::Hidden`), so they make no back patches. The hidden sides are probed
 /// again once the back patches exist. The solve proper runs after, on the new mesh.
@@ -177,14 +185,19 @@ pub fn lit_backs(
     progress.phase("looking for faces lit from behind");
     let t = Instant::now();
     let probe = crate::solve::SolveSettings {
-        tolerance: s.solve.tolerance.max(0.15),
+        tolerance: s.solve.tolerance.max(LIT_BACKS_TOLERANCE),
         energy_per_ray: None,
         error_target: None,
         final_gather: false,
+        stop_unshot: Some(LIT_BACKS_UNSHOT),
         ..s.solve.clone()
     };
     let sol = model.solve(Some(isect), &probe, &Default::default(), |_| {})?;
-    let emitted = crate::solve::scalar(&sol.stats.energy.emitted).max(f64::MIN_POSITIVE);
+    // What met backs is measured against the light that came to rest before the probe
+    // stopped: the share the rest would leave on backs too.
+    let energy = &sol.stats.energy;
+    let emitted = (crate::solve::scalar(&energy.emitted) - crate::solve::scalar(&energy.unshot))
+        .max(f64::MIN_POSITIVE);
     let mesh = &model.mesh;
     let mut per_polygon: std::collections::BTreeMap<u32, f64> = Default::default();
     for (i, &phi) in sol.back.iter().enumerate() {

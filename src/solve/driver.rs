@@ -603,6 +603,8 @@ impl<'a, I: Intersector> Driver<'a, I> {
             mean_b: self.st.mean_b(),
             elapsed,
             samples: self.st.rays + self.st.cells + in_flight,
+            unshot_flux: self.st.unshot_total() + flying,
+            emitted: scalar(&self.st.energy.emitted),
         };
         (progress, flying)
     }

@@ -187,6 +187,12 @@ pub struct SolveSettings {
     pub sky: Option<crate::sky::SkySpec>,
     /// Rays per gathered patch at the default tolerance ([`SolveSettings::gather_rays_per_patch`]).
     pub gather_rays: usize,
+    /// Stop once the light still unshot (or in flight) is below this fraction of the emitted
+    /// light: a solve that only asks where light goes, not how bright each patch is (the
+    /// first shooting that looks for faces lit from behind, `pipeline::stages::lit_backs`).
+    /// Not a flag, and not part of a saved or checkpointed solve.
+    #[serde(skip)]
+    pub stop_unshot: Option<f64>,
 }
 
 impl Default for SolveSettings {
@@ -209,6 +215,7 @@ impl Default for SolveSettings {
             final_gather: DEFAULT_FINAL_GATHER,
             gather_rays: DEFAULT_GATHER_RAYS,
             sky: None,
+            stop_unshot: None,
         }
     }
 }

@@ -25,6 +25,9 @@ pub(super) struct Progress {
     pub elapsed: f64,
     /// Form-factor samples so far: rays (cast, applied or in flight) plus hemi-cube cells.
     pub samples: u64,
+    /// Light not yet come to rest, unshot or in flight, and all emitted so far (scalar W).
+    pub unshot_flux: f64,
+    pub emitted: f64,
 }
 
 /// The verdict: `None` to go on. `has_unshot` says whether any unshot energy at all is left
@@ -48,6 +51,11 @@ pub(super) fn verdict(
         } else {
             Some(StopReason::Exhausted)
         }
+    } else if cfg
+        .stop_unshot
+        .is_some_and(|f| p.unshot_flux < f * p.emitted)
+    {
+        Some(StopReason::Converged)
     } else if cfg.max_time.is_some_and(|t| p.elapsed >= t) {
         Some(StopReason::MaxTime)
     } else if cfg.max_rays.is_some_and(|r| p.samples >= r) {
@@ -69,6 +77,8 @@ mod tests {
             mean_b: 1.0,
             elapsed: 0.0,
             samples: 0,
+            unshot_flux: 1.0,
+            emitted: 2.0,
         }
     }
 
@@ -99,5 +109,22 @@ mod tests {
             ..p
         };
         assert_eq!(verdict(&budget, &p, || true), Some(StopReason::Interrupted));
+    }
+
+    #[test]
+    fn a_probe_stops_once_most_light_has_come_to_rest() {
+        let probe = SolveSettings {
+            stop_unshot: Some(0.25),
+            ..SolveSettings::default()
+        };
+        // Half the emitted light still unshot: go on; a fifth: stop.
+        assert_eq!(verdict(&probe, &progress(1.0), || true), None);
+        let p = Progress {
+            unshot_flux: 0.4,
+            ..progress(1.0)
+        };
+        assert_eq!(verdict(&probe, &p, || true), Some(StopReason::Converged));
+        // Without the setting, the same progress goes on.
+        assert_eq!(verdict(&SolveSettings::default(), &p, || true), None);
     }
 }
