@@ -152,15 +152,29 @@ pub const LIT_BACKS_MIN: f64 = 1e-2;
 /// meets the remaining backs is below this share of the emitted light.
 pub const LIT_BACKS_LEFT: f64 = 2e-4;
 
-/// The first shooting of [`lit_backs`] samples at this tolerance at least.
+/// The first shooting of [`lit_backs`] samples at this tolerance at least ...
 pub const LIT_BACKS_TOLERANCE: f64 = 0.15;
+/// ... and with its light in no more than about this many rays' worth (n/τ², n the surface
+/// patches; `solve::ray_shots::energy_per_ray`): what it decides, polygon by polygon, is
+/// measured against the emitted light ([`LIT_BACKS_LEFT`]), so the rays it needs do not grow
+/// with the patches (a million-patch building would otherwise spend 18 M).
+pub const LIT_BACKS_RAYS: f64 = 4e6;
 /// ... and stops once less than this share of the emitted light is still unshot: where light
 /// meets backs is told by the light's first bounces, and the paper's stop (Sec. 3) would cost
 /// as many shots as the solve itself.
 pub const LIT_BACKS_UNSHOT: f64 = 0.05;
 
+/// The tolerance of [`lit_backs`]'s first shooting: [`LIT_BACKS_TOLERANCE`], looser where
+/// the surface patches would make it cast more than [`LIT_BACKS_RAYS`].
+fn lit_backs_tolerance(mesh: &crate::mesh::Mesh) -> f64 {
+    let n = (0..mesh.patches.len())
+        .filter(|&i| mesh.is_surface(i))
+        .count() as f64;
+    LIT_BACKS_TOLERANCE.max((n / LIT_BACKS_RAYS).sqrt())
+}
+
 /// Lit backs: unless the mesh is two-sided or `--one-sided` is asked for, a first shooting
-/// (no final gather, no error target, the tolerance at least [`LIT_BACKS_TOLERANCE`], until
+/// (no final gather, no error target, the tolerance at least [`lit_backs_tolerance`], until
 /// [`LIT_BACKS_UNSHOT`] of the light is left) finds where light meets the back of a one-sided
 /// face — a model wound both ways, a room inside out — and the polygons lit so get back
 /// patches of their own (appended, so the intersector stays valid), as Radiance, whose
@@ -185,7 +199,7 @@ pub fn lit_backs(
     progress.phase("looking for faces lit from behind");
     let t = Instant::now();
     let probe = crate::solve::SolveSettings {
-        tolerance: s.solve.tolerance.max(LIT_BACKS_TOLERANCE),
+        tolerance: s.solve.tolerance.max(lit_backs_tolerance(&model.mesh)),
         energy_per_ray: None,
         error_target: None,
         final_gather: false,

@@ -341,12 +341,18 @@ impl State {
         1.0 / (1.0 - r.clamp(0.0, self.rho_max.min(0.999_999)))
     }
 
-    /// The unshot flux of all patches (scalar W), from the accounts: Σ B_j·A_j less what has
-    /// been taken to be shot (a distant emitter's flux is shot without being held unshot).
-    /// O(1); rounding makes it differ from the sum over the patches in the last digits.
-    pub fn unshot_total(&self) -> f64 {
+    /// The share of the emitted light not yet come to rest: unshot, or in flight (`in_flight`,
+    /// scalar W). The unshot flux comes from the accounts, O(1): Σ B_j·A_j less what has been
+    /// taken to be shot (a distant emitter's flux is shot without being held unshot); rounding
+    /// makes it differ from the sum over the patches in the last digits.
+    pub fn unshot_share(&self, in_flight: f64) -> f64 {
+        let emitted = scalar(&self.energy.emitted);
+        if emitted <= 0.0 {
+            // Nothing emitted yet (a sky about to shoot): all of it is still to come.
+            return 1.0;
+        }
         let held = scalar(&self.b_flux) - self.shot_flux + scalar(&self.energy.distant);
-        held.max(0.0)
+        (held.max(0.0) + in_flight) / emitted
     }
 
     /// Max unshot radiosity (scalar) over the patches above the stop threshold, from the heap

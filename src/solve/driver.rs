@@ -603,8 +603,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             mean_b: self.st.mean_b(),
             elapsed,
             samples: self.st.rays + self.st.cells + in_flight,
-            unshot_flux: self.st.unshot_total() + flying,
-            emitted: scalar(&self.st.energy.emitted),
+            unshot_share: self.st.unshot_share(flying),
         };
         (progress, flying)
     }

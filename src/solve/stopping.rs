@@ -25,9 +25,8 @@ pub(super) struct Progress {
     pub elapsed: f64,
     /// Form-factor samples so far: rays (cast, applied or in flight) plus hemi-cube cells.
     pub samples: u64,
-    /// Light not yet come to rest, unshot or in flight, and all emitted so far (scalar W).
-    pub unshot_flux: f64,
-    pub emitted: f64,
+    /// The share of the emitted light not yet come to rest (unshot, or in flight).
+    pub unshot_share: f64,
 }
 
 /// The verdict: `None` to go on. `has_unshot` says whether any unshot energy at all is left
@@ -51,10 +50,7 @@ pub(super) fn verdict(
         } else {
             Some(StopReason::Exhausted)
         }
-    } else if cfg
-        .stop_unshot
-        .is_some_and(|f| p.unshot_flux < f * p.emitted)
-    {
+    } else if cfg.stop_unshot.is_some_and(|f| p.unshot_share < f) {
         Some(StopReason::Converged)
     } else if cfg.max_time.is_some_and(|t| p.elapsed >= t) {
         Some(StopReason::MaxTime)
@@ -77,8 +73,7 @@ mod tests {
             mean_b: 1.0,
             elapsed: 0.0,
             samples: 0,
-            unshot_flux: 1.0,
-            emitted: 2.0,
+            unshot_share: 0.5,
         }
     }
 
@@ -120,7 +115,7 @@ mod tests {
         // Half the emitted light still unshot: go on; a fifth: stop.
         assert_eq!(verdict(&probe, &progress(1.0), || true), None);
         let p = Progress {
-            unshot_flux: 0.4,
+            unshot_share: 0.2,
             ..progress(1.0)
         };
         assert_eq!(verdict(&probe, &p, || true), Some(StopReason::Converged));
