@@ -11,8 +11,8 @@
 //! **Waves.** Late in a solve shots are tiny (a few rays each), too small to feed two cores. So
 //! shooters are taken from the top of the queue in *waves* (about [`WAVE_RAYS`] rays, or
 //! [`CUBE_WAVE`] hemi-cubes), cast in parallel against the books at the start of the wave, and
-//! their hits applied in a fixed order. Picking a shooter costs O(log patches) (a lazily
-//! updated binary heap), never O(patches). Ray waves are pipelined: while one thread applies
+//! their hits applied in a fixed order. Picking a shooter costs O(log patches) (an indexed
+//! binary heap, `books::KeyHeap`), never O(patches). Ray waves are pipelined: while one thread applies
 //! wave k's hits, the others cast wave k + 1, which was taken off the heap before wave k's
 //! deposits reached it; its shooters are then at most one wave out of date, the books stay
 //! exact and the order stays fixed.
