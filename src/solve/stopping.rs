@@ -29,6 +29,20 @@ pub(super) struct Progress {
     pub unshot_share: f64,
 }
 
+/// With a final gather to follow, the shooting stops once the light it still owes (unshot,
+/// all bounces counted) is below this share of the emitted light, if Sec. 3's rule has not
+/// stopped it before. The gather re-estimates every patch from the solution, which then lacks
+/// only that share; Sec. 3's rule on the largest unshot *radiosity* goes on for the tail of
+/// small patches holding little light each: on a million-patch building, 4.5 M of 9.8 M shots
+/// after less than 0.1 % of the light was left, with the error estimate unchanged.
+pub const GATHER_OWED: f64 = 5e-4;
+
+/// Whether a final gather follows the shooting (`final_gather`, for the methods that cast
+/// rays).
+fn gathered(cfg: &SolveSettings) -> bool {
+    cfg.final_gather && cfg.method.casts_rays()
+}
+
 /// The verdict: `None` to go on. `has_unshot` says whether any unshot energy at all is left
 /// (asked only when the criterion holds: converged, or exhausted).
 pub(super) fn verdict(
@@ -50,7 +64,9 @@ pub(super) fn verdict(
         } else {
             Some(StopReason::Exhausted)
         }
-    } else if cfg.stop_unshot.is_some_and(|f| p.unshot_share < f) {
+    } else if cfg.stop_unshot.is_some_and(|f| p.unshot_share < f)
+        || (gathered(cfg) && p.unshot_share * p.amplification < GATHER_OWED)
+    {
         Some(StopReason::Converged)
     } else if cfg.max_time.is_some_and(|t| p.elapsed >= t) {
         Some(StopReason::MaxTime)

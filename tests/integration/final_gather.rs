@@ -78,9 +78,19 @@ fn a_patch_no_shooting_ray_hits_is_not_black() {
         g.patches >= 5 && g.rays > 0 && g.black_after < g.black_before,
         "{g:?}"
     );
-    // The shooting's books are untouched: same rays, same energy account.
-    assert_eq!(on.stats.rays, off.stats.rays);
-    assert_eq!(on.stats.energy.absorbed, off.stats.energy.absorbed);
+    // The shooting's books are the shooting's and close. With a gather to follow it stops
+    // once it owes under `GATHER_OWED` of the light: its shots are the first of the same
+    // sequence, so it has cast no more rays and absorbed less by at most what it still held.
+    assert!(on.stats.rays <= off.stats.rays);
+    let (a_on, a_off) = (
+        scalar(&on.stats.energy.absorbed),
+        scalar(&off.stats.energy.absorbed),
+    );
+    let emitted = scalar(&on.stats.energy.emitted);
+    assert!(
+        a_on <= a_off && a_off - a_on <= solve::stopping::GATHER_OWED * emitted,
+        "absorbed {a_on} against {a_off} of {emitted}"
+    );
     assert!(on.stats.energy.relative_residual() < 1e-9);
     assert!(on.b.iter().flatten().all(|v| v.is_finite()));
 
