@@ -79,19 +79,6 @@ pub struct SweepRow {
     pub bytes_per_patch: f64,
 }
 
-/// Resident set now and its high-water mark, KiB (Linux; zeros elsewhere).
-fn rss_kib() -> (f64, f64) {
-    let text = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    let field = |name: &str| {
-        text.lines()
-            .find(|l| l.starts_with(name))
-            .and_then(|l| l.split_whitespace().nth(1))
-            .and_then(|v| v.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (field("VmRSS:"), field("VmHWM:"))
-}
-
 /// Resets the high-water mark to the current resident set (Linux ≥ 4.0).
 fn reset_peak() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
@@ -177,7 +164,7 @@ fn run_one(
     method: MethodKind,
 ) -> Result<SweepRow, Error> {
     reset_peak();
-    let (base, _) = rss_kib();
+    let (base, _) = crate::report::resident_kib();
     let t = Instant::now();
     let scene = scene::load_obj(obj, &LoadOptions::default())?;
     let load_s = t.elapsed().as_secs_f64();
@@ -185,7 +172,7 @@ fn run_one(
     let model = Model::from_scene(scene, &MeshOptions::default())?;
     let m = &model.mesh;
     let mesh_s = t.elapsed().as_secs_f64();
-    let (before, _) = rss_kib();
+    let (before, _) = crate::report::resident_kib();
     let t = Instant::now();
     let isect = if method.casts_rays() {
         Some(model.intersector(job.intersector)?.0)
@@ -193,10 +180,10 @@ fn run_one(
         None
     };
     let build_s = t.elapsed().as_secs_f64();
-    let (after, _) = rss_kib();
+    let (after, _) = crate::report::resident_kib();
     let cfg = job.cfg.for_method(method);
     let sol = model.solve(isect.as_ref(), &cfg, &Default::default(), |_| {})?;
-    let (_, peak) = rss_kib();
+    let (_, peak) = crate::report::resident_kib();
     let embree = (after - before).max(0.0);
     let est = sol
         .stats

@@ -227,24 +227,29 @@ fn solve_into(
     let mut timings = Timings::default();
     let scene = stages::load(job, progress, log)?;
     timings.load = t0.elapsed().as_secs_f64();
+    timings.peak.load = report::peak_mib();
 
     let clock = Clock::start();
     let mut model = stages::mesh(job, scene, progress, log)?;
     timings.mesh = clock.seconds();
+    timings.peak.mesh = report::peak_mib();
 
     let clock = Clock::start();
     let isect = stages::intersect(job, &model, progress, log)?;
     timings.build = clock.seconds();
+    timings.peak.build = report::peak_mib();
 
     let clock = Clock::start();
     stages::sides(job, &mut model, isect.as_ref(), progress, log);
     let lit_backs = stages::lit_backs(job, &mut model, isect.as_ref(), progress, log)?;
     timings.sides = clock.seconds();
+    timings.peak.sides = report::peak_mib();
 
     let hooks = hooks::build(job, &model, log)?;
     let clock = Clock::start();
     let sol = stages::solve(job, &model, isect.as_ref(), &hooks, progress, log)?;
     (timings.solve, timings.cpu.solve) = (clock.seconds(), clock.cpu_seconds());
+    timings.peak.solve = report::peak_mib();
 
     // From here on the solution is read, not changed; this time counts as the output's.
     let after = Instant::now();

@@ -151,6 +151,7 @@ pub fn write(
     }
     timings.total = solved.t0.elapsed().as_secs_f64();
     timings.cpu.total = report::process_cpu_seconds();
+    timings.peak.output = report::peak_mib();
     let warnings = scene
         .warnings
         .iter()
@@ -235,6 +236,7 @@ fn summary(
         elements: None,
         rays_per_second: sol.stats.rays as f64 / timings.solve.max(1e-9),
         cpu_seconds: timings.cpu,
+        peak_mib: timings.peak,
         seconds: timings,
         energy,
         light_channels: sol.channels.iter().map(|c| c.name.clone()).collect(),

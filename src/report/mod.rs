@@ -264,6 +264,9 @@ pub struct Timings {
     /// The same phases' CPU time (`summary.json`: `cpu_seconds`).
     #[serde(skip)]
     pub cpu: CpuSeconds,
+    /// The peak memory at the end of each phase (`summary.json`: `peak_mib`).
+    #[serde(skip)]
+    pub peak: PeakMemory,
 }
 
 /// Process CPU time (user + system, all threads) of the phases that do the work, seconds:
@@ -276,6 +279,40 @@ pub struct CpuSeconds {
     /// Measuring the sensor grid (`--grid`).
     pub grid: f64,
     pub total: f64,
+}
+
+/// The process's peak resident memory (MiB, the high-water mark `VmHWM` of
+/// `/proc/self/status`) at the end of each phase of a solve: what a model of that size needs
+/// to have room for, phase by phase (`summary.json`: `peak_mib`). 0 where the platform does
+/// not tell.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct PeakMemory {
+    pub load: f64,
+    pub mesh: f64,
+    pub build: f64,
+    pub sides: f64,
+    pub solve: f64,
+    /// After the elements, the picture and the files: the whole run's peak.
+    pub output: f64,
+}
+
+/// The process's resident memory now and its peak so far (KiB), from `/proc/self/status`;
+/// zeros where there is none (not Linux).
+pub fn resident_kib() -> (f64, f64) {
+    let text = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let field = |name: &str| {
+        text.lines()
+            .find(|l| l.starts_with(name))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (field("VmRSS:"), field("VmHWM:"))
+}
+
+/// The peak resident memory so far, MiB ([`resident_kib`]).
+pub fn peak_mib() -> f64 {
+    resident_kib().1 / 1024.0
 }
 
 /// CPU time this process has used so far (all threads, user + system), seconds; 0 where the
@@ -384,6 +421,8 @@ pub struct Summary {
     pub rays_per_second: f64,
     pub seconds: Timings,
     pub cpu_seconds: CpuSeconds,
+    /// Peak resident memory (MiB) at the end of each phase.
+    pub peak_mib: PeakMemory,
     pub energy: EnergyReport,
     /// Names of the per-light channels kept (`--per-light`), in channel order.
     pub light_channels: Vec<String>,

@@ -45,6 +45,13 @@ fn solve_default_scene_writes_the_three_outputs() {
     for phase in ["load", "mesh", "build", "solve", "output", "total"] {
         assert!(json["seconds"][phase].as_f64().is_some(), "{phase}");
     }
+    // The peak memory at the end of each stage only grows (Linux: read from the OS).
+    let peak = |phase: &str| json["peak_mib"][phase].as_f64().unwrap();
+    let phases = ["load", "mesh", "build", "sides", "solve", "output"];
+    assert!(peak("load") > 0.0, "{}", json["peak_mib"]);
+    for w in phases.windows(2) {
+        assert!(peak(w[0]) <= peak(w[1]), "{}", json["peak_mib"]);
+    }
 }
 
 #[test]
