@@ -174,7 +174,7 @@ fn lit_backs_tolerance(mesh: &crate::mesh::Mesh) -> f64 {
 }
 
 /// Lit backs: unless the mesh is two-sided or `--one-sided` is asked for, a first shooting
-/// (no final gather, no error target, the tolerance at least [`lit_backs_tolerance`], until
+/// (no final gather, no error target, the tolerance at least `lit_backs_tolerance`, until
 /// [`LIT_BACKS_UNSHOT`] of the light is left) finds where light meets the back of a one-sided
 /// face — a model wound both ways, a room inside out — and the polygons lit so get back
 /// patches of their own (appended, so the intersector stays valid), as Radiance, whose
