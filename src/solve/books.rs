@@ -342,11 +342,12 @@ impl State {
     }
 
     /// The share of the emitted light not yet come to rest: unshot, or in flight (`in_flight`,
-    /// scalar W). The unshot flux comes from the accounts, O(1): Σ B_j·A_j less what has been
+    /// scalar W); of a sky's or the sun's, only what reached the model counts. The unshot flux comes from the accounts, O(1): Σ B_j·A_j less what has been
     /// taken to be shot (a distant emitter's flux is shot without being held unshot); rounding
     /// makes it differ from the sum over the patches in the last digits.
     pub fn unshot_share(&self, in_flight: f64) -> f64 {
-        let emitted = scalar(&self.energy.emitted);
+        // Of a distant emitter's light, what missed the model never was in it.
+        let emitted = scalar(&self.energy.emitted) - scalar(&self.energy.distant_missed);
         if emitted <= 0.0 {
             // Nothing emitted yet (a sky about to shoot): all of it is still to come.
             return 1.0;

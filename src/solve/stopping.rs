@@ -37,10 +37,12 @@ pub(super) struct Progress {
 /// after less than 0.1 % of the light was left, with the error estimate unchanged.
 pub const GATHER_OWED: f64 = 5e-4;
 
-/// Whether a final gather follows the shooting (`final_gather`, for the methods that cast
-/// rays).
+/// Whether [`GATHER_OWED`] applies: a final gather follows the shooting (`final_gather`, for
+/// the methods that cast rays) and no sky lights the model. Under a sky most of the light
+/// lands on the model's outside, so a share of all of it says little about the rooms inside:
+/// there Sec. 3's rule alone, which looks patch by patch, decides.
 fn gathered(cfg: &SolveSettings) -> bool {
-    cfg.final_gather && cfg.method.casts_rays()
+    cfg.final_gather && cfg.method.casts_rays() && cfg.sky.is_none()
 }
 
 /// The verdict: `None` to go on. `has_unshot` says whether any unshot energy at all is left
