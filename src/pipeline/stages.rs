@@ -207,11 +207,14 @@ pub fn lit_backs(
         ..s.solve.clone()
     };
     let sol = model.solve(Some(isect), &probe, &Default::default(), |_| {})?;
-    // What met backs is measured against the light that came to rest before the probe
-    // stopped: the share the rest would leave on backs too.
+    // What met backs is measured against the light that came to rest in the model before the
+    // probe stopped (a sky's light that missed it never was in it): the share the rest would
+    // leave on backs too.
     let energy = &sol.stats.energy;
-    let emitted = (crate::solve::scalar(&energy.emitted) - crate::solve::scalar(&energy.unshot))
-        .max(f64::MIN_POSITIVE);
+    let scalar = crate::solve::scalar;
+    let rested =
+        (scalar(&energy.emitted) - scalar(&energy.unshot) - scalar(&energy.distant_missed))
+            .max(f64::MIN_POSITIVE);
     let mesh = &model.mesh;
     let mut per_polygon: std::collections::BTreeMap<u32, f64> = Default::default();
     for (i, &phi) in sol.back.iter().enumerate() {
@@ -224,16 +227,16 @@ pub fn lit_backs(
     // `+ 0.0`: an empty sum is −0.0, which the summary would print as such.
     let total: f64 = per_polygon.values().sum::<f64>() + 0.0;
     let mut out = LitBacks {
-        back_fraction: total / emitted,
+        back_fraction: total / rested,
         ..LitBacks::default()
     };
-    if total >= LIT_BACKS_MIN * emitted {
+    if total >= LIT_BACKS_MIN * rested {
         let mut ranked: Vec<(u32, f64)> = per_polygon.into_iter().collect();
         ranked.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
         let mut left = total;
         let mut chosen = Vec::new();
         for (poly, phi) in ranked {
-            if left < LIT_BACKS_LEFT * emitted {
+            if left < LIT_BACKS_LEFT * rested {
                 break;
             }
             chosen.push(poly);
