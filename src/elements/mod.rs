@@ -23,6 +23,7 @@
 
 pub mod display;
 pub mod geometry;
+mod indirect;
 pub mod refine;
 
 use crate::intersect::Intersector;
@@ -356,14 +357,21 @@ pub fn refine_by<I: Intersector>(
         gather,
         b,
         seed,
-        rays,
+        // Split: a quarter of the rays to each corner's direct light, all of them to each
+        // node of the indirect light (README, "Adaptive elements").
+        rays: if light == CornerLight::Split {
+            (rays / 4).max(2)
+        } else {
+            rays
+        },
         light,
+        indirect_rays: rays,
         quantum: diagonal * 1e-6,
         inner: refine::inner_edges(mesh),
         stop,
     };
     let (work, values, capped) = refine::run(&r, rule, cap.max(mesh.patches.len()));
-    let gathered = values.map.len();
+    let gathered = values.map.len() + values.indirect.len();
     let built = display::build(&r, work, values.rays);
     let vertex_b: Vec<[f32; 3]> = built.vertex_b.iter().map(|v| v.map(|x| x as f32)).collect();
     let mut el = Elements::new(built.mesh, built.patch, vertex_b);

@@ -65,12 +65,21 @@ fn a_uniformly_lit_furnace_is_not_subdivided() {
     let (rho, ke) = (0.5, 1.0);
     let s = scene_builder::closed_box(2.0, 2.0, 2.0, scene_builder::material("m", rho, ke));
     let m = scene_builder::mesh_at(&s, Some(0.5));
-    let (_, el, st) = refined(&s, &m, &ElementSettings::default(), None);
-    assert_eq!(st.count as usize, m.patches.len(), "{st:?}");
     let exact = std::f64::consts::PI * ke / (1.0 - rho);
-    for b in &el.b {
-        for c in b {
-            assert!((c - exact).abs() < 0.03 * exact, "{c} against {exact}");
+    for light in [elements::CornerLight::Full, elements::CornerLight::Split] {
+        let settings = ElementSettings {
+            light,
+            ..Default::default()
+        };
+        let (_, el, st) = refined(&s, &m, &settings, None);
+        assert_eq!(st.count as usize, m.patches.len(), "{light:?}: {st:?}");
+        for b in &el.b {
+            for c in b {
+                assert!(
+                    (c - exact).abs() < 0.03 * exact,
+                    "{light:?}: {c} against {exact}"
+                );
+            }
         }
     }
 }
@@ -82,9 +91,21 @@ fn a_uniformly_lit_furnace_is_not_subdivided() {
 /// is not (at a threshold of 0.01, as `radiosity bench elements` measures it).
 #[test]
 fn a_sharp_shadow_edge_is_refined_to_the_minimum_size_and_only_there() {
+    shadow_edge_refined(elements::CornerLight::Full);
+}
+
+/// The same with the direct light at the corners and the indirect interpolated from nine
+/// nodes per patch (`--element-light split`): the shadow is the direct light's.
+#[test]
+fn split_corners_refine_the_shadow_edge_too() {
+    shadow_edge_refined(elements::CornerLight::Split);
+}
+
+fn shadow_edge_refined(light: elements::CornerLight) {
     let (s, m) = scene_builder::project_scene("spot.obj");
     let settings = ElementSettings {
         threshold: 0.01,
+        light,
         ..Default::default()
     };
     let (_, el, _) = refined(&s, &m, &settings, None);
@@ -162,10 +183,18 @@ fn ctrl_c_keeps_what_is_refined() {
 #[test]
 fn elements_do_not_depend_on_the_thread_count() {
     let (s, m) = scene_builder::project_scene("spot.obj");
-    let settings = ElementSettings::default();
-    let (_, one, _) = refined(&s, &m, &settings, Some(1));
-    let (_, two, _) = refined(&s, &m, &settings, Some(2));
-    assert!(one == two, "the elements differ between 1 and 2 threads");
+    for light in [elements::CornerLight::Full, elements::CornerLight::Split] {
+        let settings = ElementSettings {
+            light,
+            ..Default::default()
+        };
+        let (_, one, _) = refined(&s, &m, &settings, Some(1));
+        let (_, two, _) = refined(&s, &m, &settings, Some(2));
+        assert!(
+            one == two,
+            "{light:?}: the elements differ between 1 and 2 threads"
+        );
+    }
 }
 
 fn s(p: &Path) -> &str {

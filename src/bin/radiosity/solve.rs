@@ -103,7 +103,9 @@ pub struct ElementArgs {
     /// What each corner gathers: full (the whole light, direct and hemisphere rays) or
     /// direct (the emitters' and the sun's light by shadow rays; the indirect light
     /// interpolated from the patch solution: about a quarter of the rays, a preview that
-    /// misses the indirect light's contact shadows).
+    /// misses the indirect light's contact shadows) or split (the direct light at every
+    /// corner, the indirect light gathered at nine nodes of each patch and interpolated
+    /// quadratically: about a third of full's rays, a little more error).
     #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().light)]
     element_light: elements::CornerLight,
 }
