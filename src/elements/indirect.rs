@@ -18,10 +18,7 @@
 //! (the whole gather at every corner: 0.76 %). README, "Adaptive elements", has the costs.
 
 use super::geometry::Elem;
-use super::refine::{At, PatchWork, Refiner, Values};
-use super::CornerLight;
-use crate::intersect::Intersector;
-use crate::light::LightParts;
+use super::work::{At, PatchWork, Values};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use std::collections::HashSet;
@@ -39,11 +36,10 @@ fn nodes(e: &Elem) -> Vec<DVec2> {
     pts
 }
 
-/// The indirect light at parameters `uv` of root `root` of a patch whose work is `w`: the
-/// quadratic through the root's nodes (biquadratic on a quad's 3 × 3, the six-node quadratic
-/// on a triangle), not below 0.
-pub(super) fn at(w: &PatchWork, root: u32, uv: DVec2) -> [f64; 3] {
-    let f = &w.ind_nodes[root as usize];
+/// The indirect light at parameters `uv` of a root whose nodes have the values `f` (in the
+/// order of `nodes`; a patch's [`PatchWork::ind_nodes`]): the quadratic through them
+/// (biquadratic on a quad's 3 × 3, the six-node quadratic on a triangle), not below 0.
+pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
     let (u, v) = (uv.x, uv.y);
     let weights: Vec<f64> = if f.len() == 9 {
         let l = |t: f64| {
@@ -87,22 +83,23 @@ pub(super) fn at(w: &PatchWork, root: u32, uv: DVec2) -> [f64; 3] {
     out.map(|x| x.max(0.0))
 }
 
-/// Gathers the indirect light at the nodes of every patch's roots with `rays` rays (each
-/// distinct point once, by the lowest-numbered patch that has it; in parallel), into
-/// `values.indirect`, and sets each patch's [`PatchWork::ind_nodes`].
-pub(super) fn gather<I: Intersector>(
-    r: &Refiner<'_, I>,
+/// Gathers the indirect light at the nodes of every patch's roots (each distinct point once,
+/// by the lowest-numbered patch that has it; in parallel), into `values.indirect`, and sets
+/// each patch's [`PatchWork::ind_nodes`]. `at(patch, work, root, uv)` says where a point's
+/// value is kept and where it is gathered; `indirect(patch, x)` gathers the indirect light
+/// at `x` as that patch, with the rays it cost.
+pub(super) fn gather(
     work: &mut [PatchWork],
-    rays: usize,
+    at: impl Fn(usize, &PatchWork, u32, DVec2) -> (At, DVec3) + Sync,
+    indirect: impl Fn(usize, DVec3) -> ([f64; 3], u64) + Sync,
     values: &mut Values,
 ) {
-    debug_assert_eq!(r.light, CornerLight::Split);
     let points = |i: usize, w: &PatchWork| -> Vec<Vec<(At, DVec3)>> {
         (w.roots.iter().enumerate())
             .map(|(k, root)| {
                 let e = root.element(k as u32);
                 (nodes(&e).into_iter())
-                    .map(|uv| r.at(i, w, k as u32, uv))
+                    .map(|uv| at(i, w, k as u32, uv))
                     .collect()
             })
             .collect()
@@ -116,9 +113,7 @@ pub(super) fn gather<I: Intersector>(
             }
         }
     }
-    let got: Vec<([f64; 3], u64)> = (todo.par_iter())
-        .map(|&(_, i, x)| r.gather_part(i, x, LightParts::Indirect, rays))
-        .collect();
+    let got: Vec<([f64; 3], u64)> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
     for ((at, _, _), (b, n)) in todo.into_iter().zip(got) {
         values.indirect.insert(at, b);
         values.rays += n;
@@ -146,16 +141,9 @@ mod tests {
             let roots = Root::of_patch(pts);
             let e = roots[0].element(0);
             let f = |uv: DVec2| 1.0 + 2.0 * uv.x - uv.y + 3.0 * uv.x * uv.y + uv.x * uv.x;
-            let w = PatchWork {
-                roots: roots.clone(),
-                active: Vec::new(),
-                done: Vec::new(),
-                indirect: vec![0.0],
-                corner_b: Vec::new(),
-                ind_nodes: vec![nodes(&e).iter().map(|&uv| [f(uv); 3]).collect()],
-            };
+            let values: Vec<[f64; 3]> = nodes(&e).iter().map(|&uv| [f(uv); 3]).collect();
             for uv in [DVec2::new(0.3, 0.2), DVec2::new(0.125, 0.625)] {
-                assert!((at(&w, 0, uv)[1] - f(uv)).abs() < 1e-12);
+                assert!((at(&values, uv)[1] - f(uv)).abs() < 1e-12);
             }
         }
     }

@@ -25,6 +25,7 @@ pub mod display;
 pub mod geometry;
 mod indirect;
 pub mod refine;
+mod work;
 
 use crate::intersect::Intersector;
 use crate::light::LightAt;

@@ -38,13 +38,14 @@
 //! on the thread count.
 
 use super::geometry::{Cut, Elem, Root};
+pub(super) use super::work::{At, PatchWork, Values};
 use crate::intersect::Intersector;
 use crate::light::{LightAt, LightParts};
 use crate::mesh::Mesh;
 use crate::solve::{rng_for, scalar, Stream};
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
 
 /// A corner on a patch's boundary is gathered this fraction of the way towards the patch's
 /// centre.
@@ -124,42 +125,6 @@ pub enum Rule {
     },
     /// Every root cut to this depth (the uniform meshing adaptive elements are compared with).
     Uniform(u32),
-}
-
-/// Where a point's value is kept (module notes, "Shared points").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(super) enum At {
-    /// A point of a surface no patch boundary runs through: position, facing, material (as
-    /// the mesh welds its vertices).
-    Shared([i64; 3], [i32; 3], u32),
-    /// A point on an edge of this patch that no neighbour shares.
-    Own(u32, [i64; 3]),
-}
-
-/// The values gathered so far, and the rays they cost.
-#[derive(Default)]
-pub(super) struct Values {
-    pub map: HashMap<At, [f64; 3]>,
-    /// [`CornerLight::Split`]: the indirect light at the patches' corners.
-    pub indirect: HashMap<At, [f64; 3]>,
-    pub rays: u64,
-}
-
-/// One patch's elements while they are refined.
-pub(super) struct PatchWork {
-    pub roots: Vec<Root>,
-    /// Elements still to decide on, and the ones kept.
-    pub active: Vec<Elem>,
-    pub done: Vec<Elem>,
-    /// Per root, the scalar indirect light the contrast is taken against
-    /// ([`CornerLight::Direct`]; from the root's first test).
-    pub indirect: Vec<f64>,
-    /// The kept elements' corner values, corner after corner in the order of `done` (filled
-    /// once the refinement ends: [`finish`]).
-    pub corner_b: Vec<[f64; 3]>,
-    /// [`CornerLight::Split`]: per root, the indirect light at its quadratic's nodes
-    /// ([`super::indirect`]).
-    pub ind_nodes: Vec<Vec<[f64; 3]>>,
 }
 
 /// Everything the per-patch work reads.
@@ -320,7 +285,7 @@ impl<I: Intersector> Refiner<'_, I> {
         if self.light != CornerLight::Split {
             return b;
         }
-        let ind = super::indirect::at(w, root, uv);
+        let ind = super::indirect::at(&w.ind_nodes[root as usize], uv);
         [0, 1, 2].map(|c| b[c] + ind[c])
     }
 
@@ -690,7 +655,12 @@ pub(super) fn run<I: Intersector>(
         .collect();
     let mut values = Values::default();
     if r.light == CornerLight::Split {
-        super::indirect::gather(r, &mut work, r.indirect_rays, &mut values);
+        super::indirect::gather(
+            &mut work,
+            |i, w, root, uv| r.at(i, w, root, uv),
+            |i, x| r.gather_part(i, x, LightParts::Indirect, r.indirect_rays),
+            &mut values,
+        );
     }
     let mut total: usize = work.iter().map(|w| w.active.len()).sum();
     let mut capped = false;
