@@ -15,7 +15,7 @@
 //! table) is then neither seen by the test nor shown: on `scenes/spot.obj` it leaves a floor
 //! of 1.6 % under every mesh's error, where the full gather's is under 1 %.
 //! [`CornerLight::Split`] gathers the direct light at every point too, and the indirect part
-//! at nine nodes of each patch, interpolated quadratically beneath ([`super::indirect`]): the
+//! at nine nodes of each patch, interpolated quadratically beneath (`elements/indirect.rs`): the
 //! contact shadows' fall-off is seen at the patch's scale, for about a third of the full
 //! gather's rays.
 //!
