@@ -22,4 +22,5 @@ pub mod intersect_table;
 pub mod rays;
 pub mod shots;
 pub mod sweep;
+pub mod sweep_e2e;
 pub mod timing;

@@ -80,7 +80,7 @@ pub struct SweepRow {
 }
 
 /// Resets the high-water mark to the current resident set (Linux ≥ 4.0).
-fn reset_peak() {
+pub(crate) fn reset_peak() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
 }
 

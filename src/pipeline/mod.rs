@@ -264,11 +264,17 @@ fn solve_into(
     };
     // The elements and the gathered picture cast rays: through the solve's intersector, or
     // one built for them (the methods that cast none).
+    let clock = Clock::start();
     let built = solved.intersector_after(job)?;
     let rays = solved.isect.map(|(i, _)| i).or(built.as_ref());
     let refined = refine::refine(job, &solved, rays, log);
+    timings.elements = clock.seconds();
+    timings.peak.elements = report::peak_mib();
     let measured = daylight::measure_grid(job, &solved, log)?;
+    let clock = Clock::start();
     let picture = picture::picture(job, &solved, rays, &refined, log)?;
+    timings.picture = clock.seconds();
+    timings.peak.picture = report::peak_mib();
     let warnings = outputs::warnings(&solved, log);
 
     progress.phase("writing outputs");

@@ -258,6 +258,11 @@ pub struct Timings {
     pub sides: f64,
     pub solve: f64,
     pub output: f64,
+    /// Of `output`: refining the elements (with the intersector they need, when the method
+    /// cast no rays).
+    pub elements: f64,
+    /// Of `output`: drawing `render.png`.
+    pub picture: f64,
     /// Of `output`: measuring the sensor grid (`--grid`).
     pub grid: f64,
     pub total: f64,
@@ -292,6 +297,10 @@ pub struct PeakMemory {
     pub build: f64,
     pub sides: f64,
     pub solve: f64,
+    /// After the elements.
+    pub elements: f64,
+    /// After the picture.
+    pub picture: f64,
     /// After the elements, the picture and the files: the whole run's peak.
     pub output: f64,
 }

@@ -525,6 +525,61 @@ fn a_small_sweep_writes_its_table_and_plots() {
     assert_user_error(&["sweep", "--sizes", "0", "--out", "x"], &["--sizes"]);
 }
 
+/// The end-to-end sweep runs the whole pipeline per size: every stage timed, the elements
+/// refined (under the auto limit), the peaks rising stage by stage, the outputs removed.
+#[test]
+fn an_end_to_end_sweep_times_every_stage() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("e2e");
+    let (code, stdout, err) = run(&[
+        "sweep",
+        "--end-to-end",
+        "--sizes",
+        "1k,2k",
+        "--tolerance",
+        "0.2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(stdout.contains("Growth exponents"), "{stdout}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("end-to-end.json")).unwrap())
+            .unwrap();
+    let rows = json["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for r in rows {
+        let f = |k: &str| r[k].as_f64().unwrap();
+        assert!(
+            f("solve_s") > 0.0 && f("elements_s") > 0.0 && f("picture_s") > 0.0,
+            "{r}"
+        );
+        assert!(
+            f("elements") > f("patches") && f("element_rays") > 0.0,
+            "{r}"
+        );
+        assert!(f("gather_rays") > 0.0 && f("shoot_rays") > 0.0, "{r}");
+        let parts = f("load_s") + f("mesh_s") + f("build_s") + f("sides_s") + f("solve_s");
+        assert!(
+            parts + f("elements_s") + f("picture_s") <= f("total_s") * 1.001,
+            "{r}"
+        );
+        assert!(f("peak_solve_mib") <= f("peak_elements_mib"), "{r}");
+        assert!(
+            f("peak_elements_mib") <= f("peak_mib") && f("peak_mib") > 1.0,
+            "{r}"
+        );
+    }
+    assert_eq!(json["summaries"].as_array().unwrap().len(), 2);
+    let csv = std::fs::read_to_string(out.join("end-to-end.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 3, "{csv}");
+    assert!(!csv.contains("NaN"));
+    assert!(!out.join("1000").exists(), "the outputs are removed");
+    for png in ["end-to-end-time.png", "end-to-end-memory.png"] {
+        assert!(image::open(out.join(png)).unwrap().width() > 100);
+    }
+}
+
 /// A reader that stops early (`radiosity info … | head -1`) ends the command quietly, without
 /// a panic on the broken pipe.
 #[test]

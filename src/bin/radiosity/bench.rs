@@ -12,7 +12,7 @@ use radiosity::bench::intersect::{
 };
 use radiosity::bench::rays::{RaysJob, DEFAULT_MIN_SECONDS, DEFAULT_RAW_RAYS};
 use radiosity::bench::shots::{ShotsJob, DEFAULT_RESOLUTIONS, DEFAULT_SHOOTERS};
-use radiosity::bench::{intersect_table, rays, sweep};
+use radiosity::bench::{intersect_table, rays, sweep, sweep_e2e};
 use radiosity::elements::Test;
 use radiosity::export::write_atomic;
 use radiosity::generate::BuildingOptions;
@@ -188,6 +188,17 @@ pub struct SweepArgs {
     /// Seed of the generated buildings.
     #[arg(long, default_value_t = BuildingOptions::default().seed)]
     building_seed: u64,
+    /// Run the whole solve pipeline on each building, as `radiosity solve` does (load, mesh,
+    /// build, sides, solve and final gather, elements, picture, files), and report each
+    /// stage's time and peak memory (end-to-end.csv, end-to-end.md, end-to-end-time.png,
+    /// end-to-end-memory.png); with the first of --methods.
+    #[arg(long)]
+    end_to_end: bool,
+    /// With --end-to-end: keep each size's building and solve outputs in OUT/SIZE.
+    #[arg(long, requires = "end_to_end")]
+    keep_outputs: bool,
+    #[command(flatten)]
+    elements: super::solve::ElementArgs,
 }
 
 pub fn bench(c: BenchCommand) -> Result<(), radiosity::Error> {
@@ -357,6 +368,14 @@ pub fn sweep(a: SweepArgs) -> Result<(), radiosity::Error> {
         out: a.out.clone(),
         seed: a.building_seed,
     };
+    let settings = a.elements.settings();
+    settings.check()?;
+    if a.end_to_end {
+        let rows = sweep_e2e::run(&job, &settings, a.keep_outputs, |l| outln!("{l}"))?;
+        outln!("{}", sweep_e2e::markdown(&rows));
+        outln!("outputs in {}", a.out.display());
+        return Ok(());
+    }
     let rows = sweep::run(&job, |l| outln!("{l}"))?;
     outln!("{}", sweep::markdown(&rows, &job.methods));
     outln!("outputs in {}", a.out.display());

@@ -119,7 +119,7 @@ pub enum ElementsArg {
 }
 
 impl ElementArgs {
-    fn settings(&self) -> elements::ElementSettings {
+    pub fn settings(&self) -> elements::ElementSettings {
         elements::ElementSettings {
             enabled: self.elements != ElementsArg::Off,
             auto_limit: (self.elements == ElementsArg::Auto).then_some(elements::AUTO_MAX_PATCHES),
