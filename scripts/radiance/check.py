@@ -38,8 +38,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import objrad  # noqa: E402
-from common import (BINARY_HELP, LUMA, ROOT, oconv, parse_emit, radiance_env,  # noqa: E402
-                    radiosity_binary, ray_lines, read_patches, rtrace_rgb, run)
+from common import (BINARY_HELP, LUMA, ROOT, children_cpu, oconv, parse_emit,  # noqa: E402
+                    radiance_env, radiosity_binary, ray_lines, read_patches, rtrace_rgb, run)
 
 STRATA = 8
 
@@ -157,6 +157,7 @@ class Radiance:
                      str(args.lr), "-lw", str(args.lw), "-dt", "0", "-dc", "1", "-ds", "0.02",
                      "-dj", "0", "-dr", "0", "-u+"]
         self.seconds = 0.0
+        self.cpu_seconds = 0.0
         self.rays = 0
         self.sources = {}
 
@@ -167,11 +168,12 @@ class Radiance:
 
     def irradiance(self, octree: Path, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
         """RGB irradiance at each origin on a surface facing dirs."""
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), children_cpu()
         res = subprocess.run([self.bin / "rtrace", *self.opts, octree],
                              input=ray_lines(origins, dirs), capture_output=True, text=True,
                              env=self.env)
         self.seconds += time.perf_counter() - t0
+        self.cpu_seconds += children_cpu() - c0
         if res.returncode != 0:
             sys.exit(f"rtrace failed: {res.stderr}")
         return rtrace_rgb(res.stdout, len(origins))
@@ -353,9 +355,9 @@ def radiance_reference(args, model, rad, table, polys, ids, weight):
                                                     args.seed + 1000)
     light_seconds = time.perf_counter() - t0
     octree = rad.octree(model, "scene", light_radiance)
-    rad.seconds = 0.0
+    rad.seconds = rad.cpu_seconds = 0.0
     runs, points = reference_points(args, rad, octree, polys, ids)
-    radiance_seconds = rad.seconds
+    radiance_seconds, radiance_cpu = rad.seconds, rad.cpu_seconds
     y_runs = np.array([h @ LUMA for h in runs])
     y_ref = y_runs.mean(axis=0)
     area = table["area"][ids]
@@ -385,7 +387,72 @@ def radiance_reference(args, model, rad, table, polys, ids, weight):
             "sources": rad.sources,
             "points_per_patch": points.tolist(),
             "light_history": light_history, "light_seconds": light_seconds,
-            "seconds": radiance_seconds}
+            "seconds": radiance_seconds, "cpu_seconds": radiance_cpu}
+
+
+def one_run_noise(y_runs, aw) -> float | None:
+    """One Radiance run's area-weighted error from the reference's own runs, by leave-one-out
+    (each run against the mean of the others, scaled by sqrt((k - 1) / k), as daylight.py's
+    ``noise``): what a single run at the reference's settings would be off by."""
+    k = len(y_runs)
+    if k < 2:
+        return None
+    mean = y_runs.mean(axis=0)
+    errs = []
+    for j in range(k):
+        others = np.delete(y_runs, j, axis=0).mean(axis=0)
+        e = np.abs(y_runs[j] - others) * np.sqrt((k - 1) / k)
+        errs.append(float(np.sum(aw * e) / np.sum(aw * mean)))
+    return float(np.mean(errs))
+
+
+def match_accuracy(args, out, model, table, polys, ids, weight, y_ref, target, one_run,
+                   tries=3):
+    """``--match``: Radiance's CPU seconds at the first solve's area-weighted error, measured.
+    Single runs of the reference's own procedure (``--points``, more points where they spread,
+    ``--repeat 1``, new points) at another ``-ad``, each compared with the reference as the
+    tool is (so both errors hold the reference's own noise); the next ``-ad`` from a power law
+    error ~ ad^slope through the runs so far (slope -0.5 until two runs give one, kept within
+    [-1, -0.25]), until a run is within 15 % of ``target`` or ``tries`` runs are done. The time
+    at ``target`` is read off the same law (time ~ ad) from the run closest to it, as
+    daylight.py's ``match_accuracy``. Times are for the sampled patches only."""
+    octree = out / "scene.oct"
+    if not octree.is_file():  # a reused reference whose octree was removed: make it again
+        rad = Radiance(args, out)
+        lights, _ = light_iteration(model, rad, args.light_passes, 16, args.seed + 1000)
+        octree = rad.octree(model, "scene", lights)
+    area = table["area"][ids]
+    runs = []
+    ad = args.ad * (one_run / target) ** 2
+    slope = -0.5
+    for k in range(tries):
+        ad = int(min(max(round(ad), 8), 65536))
+        sub = argparse.Namespace(**{**vars(args), "ad": ad, "repeat": 1,
+                                    "lw": min(args.lw, 0.5 / ad),
+                                    "seed": args.seed + 7919 * (k + 1)})
+        rad = Radiance(sub, out)
+        h, points = reference_points(sub, rad, octree, polys, ids)
+        err = figures(h[0] @ LUMA, y_ref, area, weight)["area_weighted_relative_error"]
+        runs.append({"ad": ad, "area_weighted_error": err, "seconds": rad.seconds,
+                     "cpu_seconds": rad.cpu_seconds, "points": int(np.sum(points)),
+                     "rtrace": " ".join(rad.opts)})
+        print(f"  Radiance -ad {ad}, one run: {100 * err:.2f} % area-weighted against the "
+              f"reference, {rad.cpu_seconds:.1f} CPU s (target {100 * target:.2f} %)")
+        if abs(err / target - 1) < 0.15:
+            break
+        if len(runs) >= 2:
+            a, b = runs[-2], runs[-1]
+            if a["ad"] != b["ad"] and a["area_weighted_error"] > 0 and err > 0:
+                fit = np.log(err / a["area_weighted_error"]) / np.log(b["ad"] / a["ad"])
+                slope = float(min(max(fit, -1.0), -0.25))
+        ad = ad * (target / err) ** (1 / slope)
+    best = min(runs, key=lambda r: abs(np.log(r["area_weighted_error"] / target)))
+    ad_at = best["ad"] * (target / best["area_weighted_error"]) ** (1 / slope)
+    return {"target_area_weighted_error": target, "one_run_noise": one_run, "runs": runs,
+            "slope": slope, "ad_at_tool_accuracy": float(ad_at),
+            "seconds_at_tool_accuracy": best["seconds"] * ad_at / best["ad"],
+            "cpu_seconds_at_tool_accuracy": best["cpu_seconds"] * ad_at / best["ad"],
+            "by": "measured"}
 
 
 def main():
@@ -424,6 +491,10 @@ def main():
                     help="reuse Radiance's result saved in --out when made for the same model, "
                          "points and settings (to compare solver changes quickly)")
     ap.add_argument("--worst", type=int, default=10, help="worst patches listed")
+    ap.add_argument("--match", action="store_true",
+                    help="also measure Radiance's CPU seconds at the first solve's "
+                    "area-weighted error: single runs at another -ad against the reference "
+                    "(report.json radiance.matched; see match_accuracy)")
     ap.add_argument("--compare", action="append", default=[], type=Path, metavar="CSV",
                     help="no solve, no Radiance: compare this patches.csv (of a solve made "
                     "elsewhere, on the same patches) against the reference saved in --out by an "
@@ -480,6 +551,7 @@ def main():
     light_history = cached["light_history"]
     light_seconds = cached["light_seconds"]
     radiance_seconds = cached["seconds"]
+    radiance_cpu = cached.get("cpu_seconds")  # None: saved before CPU seconds were kept
 
     results = []
     for k, (solve_args, tbl, _, summary, wall) in enumerate(solves):
@@ -495,6 +567,7 @@ def main():
         "points_per_patch": args.points,
         "radiance": {"rtrace": " ".join(rad.opts), "version": "pyradiance 1.3.1 (RADIANCE 6.0a)",
                      "repeat": args.repeat, "noise": noise, "seconds": radiance_seconds,
+                     "cpu_seconds": radiance_cpu,
                      "points": int(np.sum(cached.get("points_per_patch", [args.points] * len(ids)))
                                    * args.repeat),
                      "patches_refined": int(np.sum(np.array(cached.get(
@@ -506,6 +579,20 @@ def main():
         "lit_behind_ids": lit_behind,
         "solves": results,
     }
+    aw = table["area"][ids] * weight
+    one_run = one_run_noise(y_runs, aw)
+    if one_run is not None:
+        report["radiance"]["noise"] = {**noise, "one_run_area_weighted": one_run}
+    if args.match:
+        target = results[0]["figures"]["area_weighted_relative_error"]
+        if one_run is None:
+            report["warnings"].append("--match needs --repeat 2 or more (the one-run noise)")
+        elif target <= 1.5 * noise["area_weighted"]:
+            report["warnings"].append("--match: the tool's error is within 1.5x the "
+                                      "reference's own noise; Radiance's time at it not measured")
+        else:
+            report["radiance"]["matched"] = match_accuracy(args, out, model, table, polys, ids,
+                                                           weight, y_ref, target, one_run)
     (out / "report.json").write_text(json.dumps(report, indent=1))
     print_table(report, out)
 
@@ -562,6 +649,11 @@ def print_table(r, out):
         print(f"  Radiance noise (its mean): {100 * rad['noise']['area_weighted']:.2f} % "
               f"area-weighted, {100 * rad['noise']['median_patch']:.2f} % median patch; "
               f"{rad['seconds']:.1f} s for {rad['points']} points")
+    if rad.get("matched"):
+        m = rad["matched"]
+        print(f"  Radiance at the tool's {100 * m['target_area_weighted_error']:.2f} %: "
+              f"-ad {m['ad_at_tool_accuracy']:.0f}, {m['cpu_seconds_at_tool_accuracy']:.1f} "
+              f"CPU s for the sampled patches ({m['by']}, {len(m['runs'])} runs)")
     rows = [("solve", lambda s: s["label"][:24]),
             ("area-weighted error %", lambda s: f"{100 * s['figures']['area_weighted_relative_error']:.2f}"),
             ("  signed %", lambda s: f"{100 * s['figures']['area_weighted_signed_error']:+.2f}"),
