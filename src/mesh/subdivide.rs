@@ -239,6 +239,37 @@ impl Builder {
     }
 }
 
+/// How many patches [`Builder::add_polygon`] cuts the planar convex piece `pts` into at patch
+/// size `s`, before the cuts near lights: the same divisions, counted, not made.
+pub(super) fn patches_of_piece(pts: &[Vec3], s: f32) -> f64 {
+    let div = |len: f32| ((len / s).ceil() as f64).max(1.0);
+    let longest = |p: &[Vec3]| {
+        (0..p.len())
+            .map(|k| (p[(k + 1) % p.len()] - p[k]).length())
+            .fold(0.0, f32::max)
+    };
+    match pts.len() {
+        0..=2 => 0.0,
+        3 => div(longest(pts)).powi(2),
+        4 => {
+            let along_u = (pts[1] - pts[0]).length().max((pts[2] - pts[3]).length());
+            let along_v = (pts[3] - pts[0]).length().max((pts[2] - pts[1]).length());
+            div(along_u) * div(along_v)
+        }
+        count => {
+            let c = pts.iter().copied().sum::<Vec3>() / count as f32;
+            let radius = pts.iter().map(|p| (*p - c).length()).fold(0.0, f32::max);
+            if longest(pts) <= s && radius <= s {
+                1.0
+            } else {
+                (0..count)
+                    .map(|e| div(longest(&[c, pts[e], pts[(e + 1) % count]])).powi(2))
+                    .sum()
+            }
+        }
+    }
+}
+
 /// The point a fraction `s` of the way from `a` to `b`: a + (b − a)·s, and `b` itself at
 /// s = 1. Exact in every coordinate where `a` and `b` agree, so a cut point of an axis-aligned
 /// edge lies on the edge's line, where the neighbour across it has its own vertices: glam's
