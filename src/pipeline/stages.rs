@@ -164,13 +164,25 @@ pub const LIT_BACKS_RAYS: f64 = 4e6;
 /// as many shots as the solve itself.
 pub const LIT_BACKS_UNSHOT: f64 = 0.05;
 
+/// The loosest tolerance a solve takes (`SolveSettings::check`: under 1): past about
+/// [`LIT_BACKS_RAYS`] surface patches the probe's rays grow as the patches, one a patch.
+const LIT_BACKS_LOOSEST: f64 = 0.99;
+
 /// The tolerance of [`lit_backs`]'s first shooting: [`LIT_BACKS_TOLERANCE`], looser where
-/// the surface patches would make it cast more than [`LIT_BACKS_RAYS`].
+/// the surface patches would make it cast more than [`LIT_BACKS_RAYS`] (up to
+/// [`LIT_BACKS_LOOSEST`]).
 fn lit_backs_tolerance(mesh: &crate::mesh::Mesh) -> f64 {
     let n = (0..mesh.patches.len())
         .filter(|&i| mesh.is_surface(i))
-        .count() as f64;
-    LIT_BACKS_TOLERANCE.max((n / LIT_BACKS_RAYS).sqrt())
+        .count();
+    lit_backs_tolerance_for(n as f64)
+}
+
+/// [`lit_backs_tolerance`] for `n` surface patches.
+fn lit_backs_tolerance_for(n: f64) -> f64 {
+    LIT_BACKS_TOLERANCE
+        .max((n / LIT_BACKS_RAYS).sqrt())
+        .min(LIT_BACKS_LOOSEST)
 }
 
 /// Lit backs: unless the mesh is two-sided or `--one-sided` is asked for, a first shooting
@@ -304,6 +316,29 @@ impl Solved<'_> {
             Ok(Some(self.model.intersector(job.settings.intersector)?.0))
         } else {
             Ok(None)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The probe's tolerance stays the default on small models, loosens to keep its rays near
+    /// [`LIT_BACKS_RAYS`] on large ones, and never reaches 1, which a solve refuses (a 10 M-patch
+    /// building asked for 1.59).
+    #[test]
+    fn the_probes_tolerance_is_one_a_solve_takes() {
+        assert_eq!(lit_backs_tolerance_for(10_000.0), LIT_BACKS_TOLERANCE);
+        let t = lit_backs_tolerance_for(1e6);
+        assert!((1e6 / (t * t) - LIT_BACKS_RAYS).abs() < 1.0, "{t}");
+        for n in [4e6, 1e7, 1e8] {
+            let t = lit_backs_tolerance_for(n);
+            let probe = crate::solve::SolveSettings {
+                tolerance: t,
+                ..Default::default()
+            };
+            assert!(probe.check().is_ok(), "{n} patches: tolerance {t}");
         }
     }
 }
