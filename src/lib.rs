@@ -25,7 +25,8 @@
 //! cross-checks and the scene-size sweep), [`render`] (rasteriser, false colour, glyphs),
 //! [`export`] (file formats), [`container`] (the binary container of the saved solution and
 //! the checkpoint), [`report`] (summaries, traces, plots), [`generate`] (generated
-//! buildings), [`grid`] (the sensor grid of a daylight study: placement, CSV, figures, plan).
+//! buildings), [`grid`] (the sensor grid of a daylight study: placement, CSV, figures, plan),
+//! [`photometry`] (luminaire files: IES LM-63 and EULUMDAT).
 //! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
@@ -41,6 +42,7 @@ pub mod intersect;
 pub mod light;
 pub mod mesh;
 pub mod model;
+pub mod photometry;
 pub mod pipeline;
 pub mod progress;
 pub mod random;
