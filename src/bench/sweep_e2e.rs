@@ -269,9 +269,15 @@ fn write_outputs(
     }
     let curve = |(name, f): &Column| Curve {
         label: name.to_string(),
-        points: rows.iter().map(|r| (r.patches as f64, f(r))).collect(),
+        points: (rows.iter())
+            .filter(|r| *name != "elements" || r.elements > 0)
+            .map(|r| (r.patches as f64, f(r)))
+            .collect(),
     };
-    let times: Vec<Curve> = TIMES.iter().map(curve).collect();
+    // The elements' curve only where they were refined (as their exponent in `markdown`).
+    let times: Vec<Curve> = (TIMES.iter().map(curve))
+        .filter(|c| !c.points.is_empty())
+        .collect();
     let png = plot::draw(
         "Time per stage against scene size",
         "patches",
