@@ -5,6 +5,7 @@ use crate::export::solution::SolutionError;
 use crate::export::WriteError;
 use crate::intersect::embree::EmbreeError;
 use crate::intersect::select::SelectError;
+use crate::photometry::PhotometryError;
 use crate::scene::SceneError;
 use crate::solve::SolveError;
 
@@ -28,6 +29,9 @@ pub enum Error {
     /// A saved solution that cannot be used (`render`, `export`).
     #[error(transparent)]
     Solution(#[from] SolutionError),
+    /// A luminaire file (IES, EULUMDAT) that cannot be read.
+    #[error(transparent)]
+    Photometry(#[from] PhotometryError),
     /// A bad setting (flag value, combination).
     #[error("{0}")]
     Invalid(String),

@@ -27,6 +27,7 @@
 
 mod eulumdat;
 mod ies;
+pub mod summary;
 mod web;
 
 pub use eulumdat::parse_ldt;

@@ -605,3 +605,47 @@ fn bench_timing_refuses_a_bad_grid_before_timing() {
     // The built-in Cornell box has no floor with a storey's clearance above it.
     assert_user_error(&["bench", "timing", "--grid", "0.8,0.5"], &["no sensor"]);
 }
+
+/// `info` sums up a luminaire file: its format, its flux against the lamps', its peak; a
+/// malformed one gets one line naming the file and the line, and exit code 2.
+#[test]
+fn info_sums_up_a_luminaire_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let ies = dir.path().join("Downlight.IES");
+    // A cosine (Lambertian) downlight of 1,000 cd at the nadir on 10° steps, one 4,000 lm
+    // lamp: its flux is π·1000 lm, so its light output ratio π/4 = 78.5 %.
+    let gammas: Vec<String> = (0..=9).map(|k| (10 * k).to_string()).collect();
+    let cd: Vec<String> = (0..=9)
+        .map(|k| format!("{:.3}", 1000.0 * (10.0 * k as f64).to_radians().cos()))
+        .collect();
+    let text = format!(
+        "IESNA:LM-63-2002\n[MANUFAC] ACME\nTILT=NONE\n1 4000 1 10 1 1 2 -0.2 -0.2 0\n1 1 25\n{}\n0\n{}\n",
+        gammas.join(" "),
+        cd.join(" ")
+    );
+    std::fs::write(&ies, text).unwrap();
+    let (code, out, err) = run(&["info", ies.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("IES LM-63-2002") && out.contains("manufac        ACME"),
+        "{out}"
+    );
+    // 10° steps of a cosine lose a little to the bilinear web between nodes: 78.3 %.
+    assert!(out.contains("light output ratio 78."), "{out}");
+    assert!(
+        out.contains("peak           1000 cd at C 0°, γ 0°"),
+        "{out}"
+    );
+    assert!(out.contains("circle or ellipse"), "{out}");
+    let (code, json, err) = run(&["info", ies.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let lumens = v["luminaire_lumens"].as_f64().unwrap();
+    assert!(
+        (lumens / std::f64::consts::PI / 1000.0 - 1.0).abs() < 0.01,
+        "{lumens}"
+    );
+    let bad = dir.path().join("bad.ldt");
+    std::fs::write(&bad, "ACME\n1\n9\n").unwrap();
+    assert_user_error(&["info", bad.to_str().unwrap()], &["bad.ldt:3:", "Isym"]);
+}

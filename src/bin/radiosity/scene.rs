@@ -4,11 +4,14 @@ use super::args::{source, SceneArgs};
 use crate::{out, outln};
 use clap::{Args, Subcommand};
 use radiosity::generate::{self, BuildingOptions, BUILDING_PATCH_SIZE};
+use radiosity::photometry::{self, summary};
 use std::path::PathBuf;
 
 #[derive(Args)]
 pub struct InfoArgs {
-    /// OBJ file (with its MTL beside it); the built-in Cornell box if left out.
+    /// OBJ file (with its MTL beside it); the built-in Cornell box if left out. A luminaire
+    /// file (`.ies`, `.ldt`) gets its photometry summed up: the web, its flux against the
+    /// lamps', the peak intensity, the opening.
     scene: Option<PathBuf>,
     #[command(flatten)]
     scene_args: SceneArgs,
@@ -38,6 +41,15 @@ pub enum GenerateCommand {
 }
 
 pub fn info(a: InfoArgs) -> Result<(), radiosity::Error> {
+    if let Some(path) = a.scene.as_ref().filter(|p| summary::is_photometric_file(p)) {
+        let s = summary::summarize(&photometry::read(path)?, &path.display().to_string());
+        if a.json {
+            outln!("{}", serde_json::to_string_pretty(&s).unwrap_or_default());
+        } else {
+            out!("{s}");
+        }
+        return Ok(());
+    }
     let info =
         radiosity::pipeline::info(&source(a.scene), &a.scene_args.load(), &a.scene_args.mesh())?;
     if a.json {
