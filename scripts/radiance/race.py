@@ -94,14 +94,19 @@ def bracketed(points: list[tuple[float, float]], error: float) -> bool:
     return bool(es) and min(es) <= error <= max(es)
 
 
+def common_flags(args) -> list:
+    """The flags every race's script takes from ours."""
+    return (["--radiosity", args.radiosity] if args.radiosity else []) + \
+        (["--reuse"] if args.reuse else [])
+
+
 def patch_race(py, args, work, log) -> dict:
     model = work / "furnished" / "furnished-plain.obj"
     out = work / "check"
     cmd = [py, HERE / "check.py", model, "--out", out, "--match",
            "--samples", "60" if args.quick else str(args.samples),
            "--repeat", "2", "--procs", str(args.procs)]
-    if args.radiosity:
-        cmd += ["--radiosity", args.radiosity]
+    cmd += common_flags(args)
     step(cmd, log)
     r = json.loads((out / "report.json").read_text())
     s = r["solves"][0]
@@ -131,8 +136,7 @@ def picture_race(py, args, work, log) -> dict:
     cmd = [py, HERE / "picture.py", model, "--out", out, *VIEW, *size, "--rtrace", rt]
     for m in MATCHED:
         cmd += ["--matched", m]
-    if args.radiosity:
-        cmd += ["--radiosity", args.radiosity]
+    cmd += common_flags(args)
     step(cmd, log)
     r = json.loads((out / "report.json").read_text())
     t = r["tool"]
@@ -156,8 +160,7 @@ def daylight_race(py, args, work, log) -> dict:
            "--repeat", "2", "--procs", str(args.procs)]
     if args.quick:
         cmd += ["--ad", "1024"]
-    if args.radiosity:
-        cmd += ["--radiosity", args.radiosity]
+    cmd += common_flags(args)
     step(cmd, log)
     r = json.loads((out / "report.json").read_text())
     f = r["figures"]
@@ -241,6 +244,9 @@ def main():
     ap.add_argument("--procs", type=int, default=os.cpu_count() or 1, help="rtrace -n")
     ap.add_argument("--only", choices=("patches", "picture", "daylight"), action="append",
                     help="run only these races (repeatable)")
+    ap.add_argument("--reuse", action="store_true",
+                    help="keep Radiance's references already in --work when made for the same "
+                    "model and settings (the tool is run again)")
     ap.add_argument("--radiosity", help=BINARY_HELP)
     args = ap.parse_args()
     binary = radiosity_binary(args.radiosity)
