@@ -263,14 +263,22 @@ def main():
             step([py, HERE / "furnished.py", "--out", work / "furnished", "--variant", "plain"], log)
         if "daylight" in only:
             step([py, HERE / "daylit.py", "--out", work / "daylit", "--scene", "sidelit"], log)
-        rows = [race(py, args, work, log) for name, race in
-                (("patches", patch_race), ("picture", picture_race), ("daylight", daylight_race))
-                if name in only]
-    # Every command the race ran, as step() logged it, relative to the repository.
+        rows = []
+        # The picture last: its Radiance runs (single-process rpict) take longest. The page is
+        # written after each race, so a run cut short keeps what it finished.
+        for name, race in (("patches", patch_race), ("daylight", daylight_race),
+                           ("picture", picture_race)):
+            if name in only:
+                rows.append(race(py, args, work, log))
+                log.flush()
+                write_results(results, rows, commands(work), args)
+
+
+def commands(work: Path) -> list:
+    """Every command the race ran so far, as step() logged it, relative to the repository."""
     raced = [line[2:] for line in (work / "race.log").read_text().splitlines()
              if line.startswith("$ ")]
-    rel = [c.replace(str(ROOT) + "/", "").replace(sys.executable, "$PY") for c in raced]
-    write_results(results, rows, rel, args)
+    return [c.replace(str(ROOT) + "/", "").replace(sys.executable, "$PY") for c in raced]
 
 
 if __name__ == "__main__":
