@@ -259,9 +259,14 @@ def main():
         f"race-{datetime.date.today().isoformat()}.md"
     only = set(args.only or ("patches", "picture", "daylight"))
     with open(work / "race.log", "w") as log:
-        if only & {"patches", "picture"}:
+        # With --reuse the models already written are kept: the scripts' references are keyed
+        # on the model file's time as well as its contents.
+        def keep(path: Path) -> bool:
+            return args.reuse and path.is_file()
+
+        if only & {"patches", "picture"} and not keep(work / "furnished" / "furnished-plain.obj"):
             step([py, HERE / "furnished.py", "--out", work / "furnished", "--variant", "plain"], log)
-        if "daylight" in only:
+        if "daylight" in only and not keep(work / "daylit" / "sidelit.obj"):
             step([py, HERE / "daylit.py", "--out", work / "daylit", "--scene", "sidelit"], log)
         rows = []
         # The picture last: its Radiance runs (single-process rpict) take longest. The page is
