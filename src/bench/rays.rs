@@ -141,8 +141,14 @@ impl RaysJob {
 pub fn bench_rays(job: &RaysJob) -> Result<RayBench, Error> {
     job.check()?;
     let (raw_rays, min_seconds) = (job.raw_rays, job.min_seconds);
-    // The solver's rays are what is measured: the ray shooter, whatever --method says.
-    let cfg = &job.solve.for_method(solve::MethodKind::AdaptiveRays);
+    // The solver's rays are what is measured: the ray shooter, whatever --method says, and
+    // only it — its rays over its time (the final gather and further passes would add their
+    // seconds but not their rays to `stats`).
+    let cfg = &SolveSettings {
+        final_gather: false,
+        error_target: None,
+        ..job.solve.for_method(solve::MethodKind::AdaptiveRays)
+    };
     let model = Model::load(&job.source, &job.load, &job.mesh)?;
     let (scene, m) = (&model.scene, &model.mesh);
     let (isect, chosen) = model.intersector(job.intersector)?;
