@@ -26,7 +26,9 @@
 //! [`export`] (file formats), [`container`] (the binary container of the saved solution and
 //! the checkpoint), [`report`] (summaries, traces, plots), [`generate`] (generated
 //! buildings), [`grid`] (the sensor grid of a daylight study: placement, CSV, figures, plan),
-//! [`photometry`] (luminaire files: IES LM-63 and EULUMDAT).
+//! [`photometry`] (luminaire files: IES LM-63 and EULUMDAT), [`luminaire`] (placed
+//! luminaires: position, aiming frame, intensity toward a direction, the `--luminaires`
+//! schedule).
 //! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
@@ -40,6 +42,7 @@ pub mod generate;
 pub mod grid;
 pub mod intersect;
 pub mod light;
+pub mod luminaire;
 pub mod mesh;
 pub mod model;
 pub mod photometry;
