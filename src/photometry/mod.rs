@@ -1,7 +1,8 @@
 //! Luminaire photometry: how much light a real luminaire sends in each direction, read from
 //! the two file formats lighting manufacturers publish.
 //!
-//! This module owns reading photometric files, and nothing else. Two formats:
+//! This module owns reading photometric files and what follows from a web alone (its flux,
+//! its cells of equal flux: `cells.rs`). Two formats:
 //!
 //! - IES (`.ies`): ANSI/IES LM-63-19, *Approved Method: IES Standard File Format for the
 //!   Electronic Transfer of Photometric Data and Related Information*, and its earlier editions
@@ -25,6 +26,7 @@
 //! Errors: a malformed file gives one [`PhotometryError`] that names the file, the 1-based line
 //! and what is wrong. No input makes a parser panic.
 
+pub mod cells;
 mod eulumdat;
 mod ies;
 pub mod summary;
