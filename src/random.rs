@@ -37,6 +37,8 @@ pub enum Stream {
     /// The probes that find the hidden sides of surfaces (`u64::MAX − 6`,
     /// `intersect::hidden`).
     Hidden,
+    /// The luminaires' shots (`u64::MAX − 7`, `solve::luminaire_shots`).
+    Luminaires,
 }
 
 /// Regather round k draws under `Stream::Gather`'s number less k times this.
@@ -55,6 +57,7 @@ impl Stream {
             Stream::Picture => u64::MAX - 4,
             Stream::Elements => u64::MAX - 5,
             Stream::Hidden => u64::MAX - 6,
+            Stream::Luminaires => u64::MAX - 7,
         }
     }
 }

@@ -151,6 +151,9 @@ impl<I: Intersector> Kernel<'_, I> {
         if let Some(sun) = sun.filter(|_| split.sun > 0) {
             self.sun_part(spot, sun, split.sun, &mut g, rng);
         }
+        if !self.mesh.luminaires.is_empty() && ask.parts != LightParts::Indirect {
+            self.luminaires_part(spot, ask.rays, &mut g, rng);
+        }
         if ask.parts != LightParts::Direct {
             self.hemisphere_part(spot, &split, &mut g, rng);
         }

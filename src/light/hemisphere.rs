@@ -228,7 +228,8 @@ impl<I: Intersector> Kernel<'_, I> {
     }
 
     /// ρ_r times the irradiance at `y` on side `r`, from one light sample, one cosine-weighted
-    /// ray (its hit taken by [`Self::reflected_at`] one level deeper) and one sun sample.
+    /// ray (its hit taken by [`Self::reflected_at`] one level deeper), one sun sample and one
+    /// luminaire's light.
     fn followed<R: Rng>(&self, r: usize, y: Vec3, depth: u32, rng: &mut R) -> Reflected {
         let k = self.sol.channels.len();
         let n = self.mesh.patches[r].normal;
@@ -286,6 +287,17 @@ impl<I: Intersector> Kernel<'_, I> {
             let l = self.sun_sample(&from, sun, (rng.gen(), rng.gen()));
             acc.v += l;
             add_to(&mut acc.ch, self.sky.sun_channel, l, Rgb::ONE);
+        }
+        if !self.mesh.luminaires.is_empty() {
+            // One luminaire, drawn by its flux: its exact light at y by a shadow ray.
+            let (l, k, cast) = self.luminaire_by_flux(&from, rng.gen());
+            acc.rays += u64::from(cast);
+            acc.v += l;
+            if let Some(c) =
+                (self.luminaire_channels.get(k).copied().flatten()).and_then(|c| acc.ch.get_mut(c))
+            {
+                *c += l;
+            }
         }
         if let Some((s, t2)) = self.receiver_of(hit) {
             let emitted = self.emitted_towards(s, (n, dir, t2), &Draw::by_power(), (nl, 1.0));

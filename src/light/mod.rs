@@ -52,6 +52,7 @@ pub mod emitters;
 pub mod gather;
 pub mod hemisphere;
 pub mod light_at;
+pub mod luminaires;
 pub mod sun;
 
 pub use gather::LightParts;
@@ -141,6 +142,10 @@ pub(crate) struct Kernel<'a, I> {
     pub glazing: Vec<Rgb>,
     /// The smallest offset off a surface, from the model's extent (f32 rounding).
     pub eps_floor: f32,
+    /// Each luminaire's light channel (`--per-light`, by its group's name), if it has one.
+    pub luminaire_channels: Vec<Option<usize>>,
+    /// The luminaires' cumulative shares of their flux (`luminaires::flux_cdf`).
+    pub luminaire_flux_cdf: Vec<f64>,
 }
 
 impl<'a, I> Kernel<'a, I> {
@@ -160,6 +165,9 @@ impl<'a, I> Kernel<'a, I> {
         let t = |p: &crate::mesh::Patch| {
             Rgb::from_array(materials[p.material as usize].transmittance_rgb())
         };
+        let luminaire_channels = (mesh.luminaires.iter())
+            .map(|l| sol.channels.iter().position(|c| c.name == l.group))
+            .collect();
         Kernel {
             mesh,
             isect,
@@ -172,6 +180,8 @@ impl<'a, I> Kernel<'a, I> {
                 Vec::new()
             },
             eps_floor: reach * 5e-7,
+            luminaire_channels,
+            luminaire_flux_cdf: luminaires::flux_cdf(&mesh.luminaires),
         }
     }
 

@@ -102,6 +102,9 @@ pub struct Mesh {
     pub hidden: Hidden,
     /// Where faces lie on faces facing them (`Mesh::find_contacts`); empty until found.
     pub contacts: Contacts,
+    /// The scene's luminaires (`Scene::luminaires`): lights with no patch, which shoot first
+    /// and are gathered by shadow rays (`solve::luminaire_shots`, `light::luminaires`).
+    pub luminaires: Vec<crate::luminaire::Luminaire>,
 }
 
 impl Mesh {
@@ -280,6 +283,7 @@ pub fn build(scene: &Scene, opts: &MeshOptions) -> Mesh {
             }
         }
     }
+    b.mesh.luminaires = scene.luminaires.clone();
     b.mesh
 }
 

@@ -205,6 +205,7 @@ fn summary(
         patch_size: m.patch_size,
         axial_fraction_area: report::axial_fractions(m).1,
         lights: report::lights(scene, m),
+        luminaires: report::luminaires(scene),
         method: s.method.name(),
         intersector: solved
             .isect

@@ -25,6 +25,38 @@ pub struct LightInfo {
     pub power: [f64; 3],
 }
 
+/// A placed luminaire (`--luminaires`) and the light it puts out.
+#[derive(Clone, Debug, Serialize)]
+pub struct LuminaireInfo {
+    pub name: String,
+    pub group: String,
+    /// Its photometric file.
+    pub file: String,
+    /// Its photometric centre, m.
+    pub position: [f64; 3],
+    /// Where it aims (γ = 0), a unit direction.
+    pub aim: [f64; 3],
+    /// Luminous flux, lm: the web's × light-loss factor × count × tilt factor.
+    pub lumens: f64,
+    /// Radiant flux per channel at 179 lm/W, W.
+    pub watts: [f64; 3],
+}
+
+/// The scene's luminaires as the summaries list them.
+pub fn luminaires(scene: &Scene) -> Vec<LuminaireInfo> {
+    (scene.luminaires.iter())
+        .map(|l| LuminaireInfo {
+            name: l.name.clone(),
+            group: l.group.clone(),
+            file: l.file.display().to_string(),
+            position: l.position.to_array(),
+            aim: l.frame.aim.to_array(),
+            lumens: l.flux_lumens(),
+            watts: l.flux_watts(),
+        })
+        .collect()
+}
+
 #[derive(Clone, Debug, Serialize)]
 pub struct MaterialInfo {
     pub name: String,
@@ -67,6 +99,8 @@ pub struct SceneInfo {
     pub bounds_max: [f32; 3],
     pub materials: Vec<MaterialInfo>,
     pub lights: Vec<LightInfo>,
+    /// Luminaires placed by `--luminaires` (empty without).
+    pub luminaires: Vec<LuminaireInfo>,
     /// What `--intersector auto` picks for this scene, and why.
     pub intersector: &'static str,
     pub intersector_reason: String,
@@ -147,6 +181,7 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
             })
             .collect(),
         lights: lights(scene, mesh),
+        luminaires: luminaires(scene),
         intersector: auto.name(),
         intersector_reason: why,
         warnings: scene.warnings.clone(),
@@ -235,6 +270,23 @@ impl std::fmt::Display for SceneInfo {
                 l.power[1],
                 l.power[2]
             )?;
+        }
+        if !self.luminaires.is_empty() {
+            let total: f64 = self.luminaires.iter().map(|l| l.lumens).sum();
+            writeln!(
+                f,
+                "luminaires     {} ({:.0} lm in all)",
+                self.luminaires.len(),
+                total
+            )?;
+            for l in &self.luminaires {
+                let (p, a) = (l.position, l.aim);
+                writeln!(
+                    f,
+                    "  {:<20} {:.0} lm at {:.3},{:.3},{:.3} aimed {:.3},{:.3},{:.3} (group {}; {})",
+                    l.name, l.lumens, p[0], p[1], p[2], a[0], a[1], a[2], l.group, l.file
+                )?;
+            }
         }
         writeln!(
             f,
@@ -389,6 +441,9 @@ pub struct Summary {
     pub patch_size: f32,
     pub axial_fraction_area: f64,
     pub lights: Vec<LightInfo>,
+    /// Luminaires placed by `--luminaires` (left out without).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub luminaires: Vec<LuminaireInfo>,
     pub method: &'static str,
     pub intersector: &'static str,
     /// Why that intersector (the `auto` rule's reason, or "forced by --intersector").

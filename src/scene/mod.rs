@@ -34,11 +34,18 @@ impl SceneSource {
     }
 
     /// Loads the scene.
+    /// Loads the scene, and the luminaires' schedule when the options name one.
     pub fn load(&self, opts: &LoadOptions) -> Result<Scene, SceneError> {
-        match self {
+        let mut scene = match self {
             SceneSource::Default => default_scene(opts),
             SceneSource::File(p) => load_obj(p, opts),
+        }?;
+        if let Some(path) = &opts.luminaires {
+            let zenith = Vec3::from(opts.zenith.unwrap_or(crate::sky::DEFAULT_ZENITH.to_array()));
+            scene.luminaires = crate::luminaire::read_schedule(path, zenith.as_dvec3())
+                .map_err(|e| SceneError::from_line(&path.display().to_string(), &e.to_string()))?;
         }
+        Ok(scene)
     }
 }
 
@@ -185,6 +192,9 @@ pub struct Scene {
     pub patch_size_hint: Option<f32>,
     /// Coincident polygons merged at load time ([`sides::merge_coincident`]).
     pub merged: sides::Merged,
+    /// Luminaires placed in the model by a schedule (`--luminaires`): point sources with a
+    /// photometric web, shot first and gathered exactly ([`crate::luminaire`]).
+    pub luminaires: Vec<crate::luminaire::Luminaire>,
 }
 
 impl Scene {

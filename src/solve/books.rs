@@ -10,150 +10,10 @@
 //! time went into popping them).
 
 use super::estimate::{self, Books, Estimator};
+use super::key_heap::KeyHeap;
 use super::{scalar, EnergyBalance, SolveStats, TracePoint};
 use crate::mesh::Mesh;
 use crate::scene::Material;
-use std::cmp::Ordering;
-
-/// A heap entry: a key and the patch it was computed for; ordered by key, ties to the lower
-/// patch number.
-#[derive(Clone, Copy, PartialEq)]
-pub(super) struct Entry(pub f64, pub u32);
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Entry {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.0.total_cmp(&o.0).then(o.1.cmp(&self.1))
-    }
-}
-
-/// Max-heap of patches by a key, indexed: each patch is in it at most once, at the position
-/// `pos` records, so a key that changes is moved in place (O(log patches)) rather than
-/// pushed again. Ties go to the lower patch number ([`Entry`]'s order). A patch whose key
-/// changed without [`Self::set`] (a shooter, zeroed when taken) is put right when it comes
-/// to the top ([`Self::peek`]).
-#[derive(Default)]
-pub(super) struct KeyHeap {
-    heap: Vec<Entry>,
-    /// Position of each patch in `heap`; [`ABSENT`] when it is not in it.
-    pos: Vec<u32>,
-}
-
-/// [`KeyHeap::pos`] of a patch not in the heap.
-const ABSENT: u32 = u32::MAX;
-
-impl KeyHeap {
-    fn with_patches(n: usize) -> KeyHeap {
-        KeyHeap {
-            heap: Vec::new(),
-            pos: vec![ABSENT; n],
-        }
-    }
-
-    /// Patch `i`'s key is now `key`: inserted, moved, or (key ≤ 0) taken out.
-    fn set(&mut self, key: f64, i: usize) {
-        if key <= 0.0 {
-            self.remove(i);
-            return;
-        }
-        let e = Entry(key, i as u32);
-        match self.pos[i] {
-            ABSENT => {
-                self.heap.push(e);
-                self.pos[i] = (self.heap.len() - 1) as u32;
-                self.up(self.heap.len() - 1);
-            }
-            p => {
-                let p = p as usize;
-                let old = std::mem::replace(&mut self.heap[p], e);
-                if e > old {
-                    self.up(p);
-                } else {
-                    self.down(p);
-                }
-            }
-        }
-    }
-
-    /// Takes patch `i` out, if it is in.
-    fn remove(&mut self, i: usize) {
-        let p = self.pos[i];
-        if p == ABSENT {
-            return;
-        }
-        let p = p as usize;
-        self.pos[i] = ABSENT;
-        let last = self
-            .heap
-            .pop()
-            .expect("a patch with a position is in the heap");
-        if p < self.heap.len() {
-            self.heap[p] = last;
-            self.pos[last.1 as usize] = p as u32;
-            self.up(p);
-            self.down(self.pos[last.1 as usize] as usize);
-        }
-    }
-
-    /// The top entry, its key checked against `key_of` (and put right first where stale).
-    fn peek(&mut self, key_of: impl Fn(usize) -> f64) -> Option<Entry> {
-        while let Some(&top) = self.heap.first() {
-            let key = key_of(top.1 as usize);
-            if key == top.0 {
-                return Some(top);
-            }
-            self.set(key, top.1 as usize);
-        }
-        None
-    }
-
-    /// Takes the top entry out.
-    fn pop(&mut self) {
-        if let Some(top) = self.heap.first() {
-            self.remove(top.1 as usize);
-        }
-    }
-
-    fn up(&mut self, mut k: usize) {
-        while k > 0 {
-            let parent = (k - 1) / 2;
-            if self.heap[k] <= self.heap[parent] {
-                break;
-            }
-            self.swap(k, parent);
-            k = parent;
-        }
-    }
-
-    fn down(&mut self, mut k: usize) {
-        let n = self.heap.len();
-        loop {
-            let (l, r) = (2 * k + 1, 2 * k + 2);
-            let mut big = k;
-            if l < n && self.heap[l] > self.heap[big] {
-                big = l;
-            }
-            if r < n && self.heap[r] > self.heap[big] {
-                big = r;
-            }
-            if big == k {
-                break;
-            }
-            self.swap(k, big);
-            k = big;
-        }
-    }
-
-    fn swap(&mut self, a: usize, b: usize) {
-        self.heap.swap(a, b);
-        self.pos[self.heap[a].1 as usize] = a as u32;
-        self.pos[self.heap[b].1 as usize] = b as u32;
-    }
-}
 
 /// a += b, per channel.
 #[inline]
@@ -545,6 +405,15 @@ impl State {
         self.shot_flux += scalar(phi);
     }
 
+    /// A luminaire ([`super::luminaire_shots`]) shoots `phi`: emitted from a point no patch
+    /// holds, so never held unshot (in `distant`'s account, with the other emitters that have
+    /// no patch; its rays that meet nothing or a back count as any shot's).
+    pub fn emit_point(&mut self, phi: &[f64; 3]) {
+        add3(&mut self.energy.emitted, phi);
+        add3(&mut self.energy.distant, phi);
+        self.shot_flux += scalar(phi);
+    }
+
     /// Flux from a distant emitter that arrived on a back face (absorbed there): a one-sided
     /// model's outside, not a winding error.
     #[inline]
@@ -747,51 +616,5 @@ impl State {
         };
         stats.trace.push(p);
         on_trace(&p);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use rand::{Rng, SeedableRng};
-
-    /// The indexed heap gives the same top as a scan over the current keys, whatever mix of
-    /// inserts, moves up and down, removals and pops, ties to the lower patch number; a key
-    /// lowered without `set` (as a shooter's is, zeroed when taken) is put right at the top.
-    #[test]
-    fn key_heap_top_is_the_largest_current_key() {
-        let n = 200;
-        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
-        let mut keys = vec![0.0f64; n];
-        let mut heap = KeyHeap::with_patches(n);
-        for step in 0..20_000 {
-            let i = rng.gen_range(0..n);
-            match rng.gen_range(0..6) {
-                // Few distinct keys, so ties are common.
-                0 | 1 => {
-                    keys[i] = rng.gen_range(0..8) as f64;
-                    heap.set(keys[i], i);
-                    assert_eq!(heap.pos[i] != ABSENT, keys[i] > 0.0, "step {step}");
-                }
-                2 => {
-                    keys[i] = 0.0;
-                    heap.remove(i);
-                }
-                3 => keys[i] *= 0.5,
-                4 => keys[i] = 0.0,
-                _ => {
-                    if let Some(top) = heap.peek(|j| keys[j]) {
-                        keys[top.1 as usize] = 0.0;
-                        heap.pop();
-                    }
-                }
-            }
-            let want = (0..n)
-                .filter(|&j| keys[j] > 0.0)
-                .map(|j| Entry(keys[j], j as u32))
-                .max();
-            let got = heap.peek(|j| keys[j]);
-            assert_eq!(got.map(|e| e.1), want.map(|e| e.1), "step {step}");
-        }
     }
 }

@@ -12,7 +12,7 @@
 //! shooters are taken from the top of the queue in *waves* (about [`WAVE_RAYS`] rays, or
 //! [`CUBE_WAVE`] hemi-cubes), cast in parallel against the books at the start of the wave, and
 //! their hits applied in a fixed order. Picking a shooter costs O(log patches) (an indexed
-//! binary heap, `books::KeyHeap`), never O(patches). Ray waves are pipelined: while one thread applies
+//! binary heap, `key_heap::KeyHeap`), never O(patches). Ray waves are pipelined: while one thread applies
 //! wave k's hits, the others cast wave k + 1, which was taken off the heap before wave k's
 //! deposits reached it; its shooters are then at most one wave out of date, the books stay
 //! exact and the order stays fixed.
@@ -28,8 +28,9 @@
 
 use super::books::{self, State};
 use super::cube_shots::{self, CubeHits, CubeKind, CubeShooter, CubeShot, CUBE_WAVE};
-use super::estimate::Estimator;
+use super::estimate::PatchScalars;
 use super::final_gather;
+use super::luminaire_shots;
 use super::ray_shots::{
     apply_rays, energy_per_ray, grid_for, tasks_of, Hits, RayCaster, RayShot, Task, BACK, WAVE_RAYS,
 };
@@ -124,6 +125,7 @@ pub fn shoot_with<I: Intersector>(
         d.resume(saved)?;
     } else {
         d.shoot_sky();
+        d.shoot_luminaires();
     }
     let reason = d.run(start, &mut on_trace)?;
     // The final gather re-estimates the patches the shooting left noisy (not after Ctrl-C);
@@ -232,67 +234,6 @@ const GATHER_RAY_COST: f64 = 2.0;
 /// Fewest rays per patch a gather cut to the time left is run with.
 const MIN_BUDGET_GATHER: usize = 16;
 
-/// Per-patch scalars of the solver's error estimate.
-pub(super) struct PatchScalars {
-    pub(super) area: Vec<f64>,
-    pub(super) emission: Vec<f64>,
-    pub(super) rho: Vec<f64>,
-    rho_mean: f64,
-    /// Sides of two-sided surfaces (empty if the mesh has none).
-    other_side: Vec<u32>,
-    /// Hidden sides (empty if none is: `crate::mesh::Hidden`).
-    hidden: Vec<bool>,
-}
-
-impl PatchScalars {
-    pub(super) fn new(mesh: &Mesh, materials: &[Material]) -> PatchScalars {
-        let material = |p: &crate::mesh::Patch| &materials[p.material as usize];
-        let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
-        let rho: Vec<f64> = mesh
-            .patches
-            .iter()
-            .map(|p| scalar(&material(p).rho))
-            .collect();
-        let other_side = if mesh.back_twins() > 0 {
-            let other = |i: usize| mesh.other_side(i).map_or(u32::MAX, |o| o as u32);
-            (0..mesh.patches.len()).map(other).collect()
-        } else {
-            Vec::new()
-        };
-        let hidden = if mesh.hidden.count(mesh).0 > 0 {
-            (0..mesh.patches.len())
-                .map(|i| mesh.hidden.side(mesh, i))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        PatchScalars {
-            other_side,
-            hidden,
-            emission: mesh
-                .patches
-                .iter()
-                .map(|p| scalar(&material(p).emission()))
-                .collect(),
-            rho_mean: rho.iter().zip(&area).map(|(r, a)| r * a).sum::<f64>() / mesh.total_area(),
-            area,
-            rho,
-        }
-    }
-
-    pub(super) fn estimator(&self, energy_per_ray: f64) -> Estimator<'_> {
-        Estimator {
-            area: &self.area,
-            emission: &self.emission,
-            rho: &self.rho,
-            energy_per_ray,
-            rho_mean: self.rho_mean,
-            other_side: &self.other_side,
-            hidden: &self.hidden,
-        }
-    }
-}
-
 /// A ray wave cast but not yet applied.
 struct Pending {
     wave: Vec<RayShot>,
@@ -360,7 +301,14 @@ impl<'a, I: Intersector> Driver<'a, I> {
                 .iter()
                 .any(|p| scalar(&p.radiance) * p.solid_angle > 0.0)
         });
-        if scalar(&st.energy.emitted) <= 0.0 && !sky_lit {
+        let from_luminaires = luminaire_shots::emitted_flux(&mesh.luminaires);
+        if !mesh.luminaires.is_empty() && !method.casts_rays() {
+            return Err(SolveError::LuminairesNeedRays(method.name()));
+        }
+        if scalar(&st.energy.emitted) <= 0.0
+            && !sky_lit
+            && from_luminaires.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+        {
             return Err(SolveError::NoEmitter);
         }
         if let Some(g) = &hooks.light_groups {
@@ -403,10 +351,10 @@ impl<'a, I: Intersector> Driver<'a, I> {
             }
             _ => 0.0,
         };
-        let c = cfg
-            .energy_per_ray
-            .filter(|c| *c > 0.0)
-            .unwrap_or_else(|| energy_per_ray(mesh, &rho, emitted + from_sky, cfg.tolerance));
+        let c = cfg.energy_per_ray.filter(|c| *c > 0.0).unwrap_or_else(|| {
+            let all = emitted + from_sky + from_luminaires;
+            energy_per_ray(mesh, &rho, all, cfg.tolerance)
+        });
         let cubes = match method {
             MethodKind::Hemicube | MethodKind::HemicubeJittered => Some(CubeKind::Uniform {
                 n: cfg.hemicube_n,
@@ -466,6 +414,27 @@ impl<'a, I: Intersector> Driver<'a, I> {
             );
             self.stats.shots += done.shots;
         }
+    }
+
+    /// The luminaires shoot, after the sky and before any patch ([`luminaire_shots`]).
+    fn shoot_luminaires(&mut self) {
+        let (Some(caster), false) = (&self.caster, self.mesh.luminaires.is_empty()) else {
+            return;
+        };
+        let groups = self.hooks.light_groups.as_ref();
+        let luminaires = &self.mesh.luminaires;
+        let of: Vec<Option<usize>> = (luminaires.iter())
+            .map(|l| groups.and_then(|g| g.channel(&l.group)))
+            .collect();
+        let done = luminaire_shots::shoot(
+            &mut self.st,
+            caster,
+            luminaires,
+            self.energy_per_ray,
+            self.cfg.seed,
+            groups.map(|g| (g.len(), of.as_slice())),
+        );
+        self.stats.shots += done.shots;
     }
 
     /// What a checkpoint keeps at a safe point (see [`Saved`]).

@@ -26,6 +26,8 @@
 //! factor of 2 of the measured error over whole runs.
 
 use super::scalar;
+use crate::mesh::Mesh;
+use crate::scene::Material;
 
 /// The paper's two metrics and the RMS relative error, as fractions (0.01 = 1 %).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -200,6 +202,67 @@ impl Estimator<'_> {
     pub fn metrics(&self, books: &Books) -> ErrorMetrics {
         let (err, b) = self.per_patch(books);
         from_errors(self.area, err.into_iter(), &b)
+    }
+}
+
+/// Per-patch scalars of the solver's error estimate.
+pub(super) struct PatchScalars {
+    pub(super) area: Vec<f64>,
+    pub(super) emission: Vec<f64>,
+    pub(super) rho: Vec<f64>,
+    rho_mean: f64,
+    /// Sides of two-sided surfaces (empty if the mesh has none).
+    other_side: Vec<u32>,
+    /// Hidden sides (empty if none is: `crate::mesh::Hidden`).
+    hidden: Vec<bool>,
+}
+
+impl PatchScalars {
+    pub(super) fn new(mesh: &Mesh, materials: &[Material]) -> PatchScalars {
+        let material = |p: &crate::mesh::Patch| &materials[p.material as usize];
+        let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
+        let rho: Vec<f64> = mesh
+            .patches
+            .iter()
+            .map(|p| scalar(&material(p).rho))
+            .collect();
+        let other_side = if mesh.back_twins() > 0 {
+            let other = |i: usize| mesh.other_side(i).map_or(u32::MAX, |o| o as u32);
+            (0..mesh.patches.len()).map(other).collect()
+        } else {
+            Vec::new()
+        };
+        let hidden = if mesh.hidden.count(mesh).0 > 0 {
+            (0..mesh.patches.len())
+                .map(|i| mesh.hidden.side(mesh, i))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        PatchScalars {
+            other_side,
+            hidden,
+            emission: mesh
+                .patches
+                .iter()
+                .map(|p| scalar(&material(p).emission()))
+                .collect(),
+            rho_mean: rho.iter().zip(&area).map(|(r, a)| r * a).sum::<f64>() / mesh.total_area(),
+            area,
+            rho,
+        }
+    }
+
+    pub(super) fn estimator(&self, energy_per_ray: f64) -> Estimator<'_> {
+        Estimator {
+            area: &self.area,
+            emission: &self.emission,
+            rho: &self.rho,
+            energy_per_ray,
+            rho_mean: self.rho_mean,
+            other_side: &self.other_side,
+            hidden: &self.hidden,
+        }
     }
 }
 

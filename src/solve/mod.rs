@@ -37,7 +37,9 @@ pub mod cube_shots;
 pub mod driver;
 pub mod estimate;
 pub mod final_gather;
+mod key_heap;
 pub mod lights;
+pub mod luminaire_shots;
 pub mod matrix;
 pub mod passes;
 pub mod ray_shots;
@@ -134,7 +136,8 @@ pub struct EnergyBalance {
     pub escaped: [f64; 3],
     /// Still waiting to be shot.
     pub unshot: [f64; 3],
-    /// Of `emitted`, what distant emitters (sky, ground glow, sun) shot at the model.
+    /// Of `emitted`, what the emitters no patch holds shot: the distant ones (sky, ground
+    /// glow, sun) at the model, and the luminaires.
     #[serde(default)]
     pub distant: [f64; 3],
     /// Of `absorbed_back`, what came from distant emitters (a one-sided model's outside).
@@ -287,6 +290,10 @@ pub enum SolveError {
         "--sky needs a method that casts rays (adaptive-hybrid or adaptive-rays), not --method {0}"
     )]
     SkyNeedsRays(&'static str),
+    #[error(
+        "--luminaires needs a method that casts rays (adaptive-hybrid or adaptive-rays), not --method {0}"
+    )]
+    LuminairesNeedRays(&'static str),
 }
 
 /// Solves by the method `cfg.method` names, casting rays through `isect`, with no hooks.

@@ -114,6 +114,36 @@ impl Hits {
     }
 }
 
+/// The rays of a batch of chunks (`batch`, of [`CHUNK`] rays each, `x` rays in all) shot by an
+/// emitter no patch holds (a sky piece, a luminaire), cast in parallel: chunk `ch` draws its
+/// random numbers from `rng_of(ch)` and ray `r` is `ray(r, rng)` (an origin and a direction).
+/// The hits per chunk, in ray order, so what a ray meets never depends on the thread.
+pub(super) fn cast_free<I: Intersector, R: Rng>(
+    caster: &RayCaster<'_, I>,
+    batch: &[usize],
+    x: usize,
+    rng_of: impl Fn(usize) -> R + Sync,
+    ray: impl Fn(usize, &mut R) -> (Vec3, Vec3) + Sync,
+) -> Vec<Hits> {
+    use rayon::prelude::*;
+    batch
+        .par_iter()
+        .map(|&ch| {
+            let mut rng = rng_of(ch);
+            let mut out = Hits::default();
+            for r in ch * CHUNK..(ch * CHUNK + CHUNK).min(x) {
+                let (org, dir) = ray(r, &mut rng);
+                let (code, tint) = caster.trace(None, org, dir, 0.0, &mut rng);
+                if let Some(t) = tint {
+                    out.tinted.push((out.codes.len() as u32, t));
+                }
+                out.codes.push(code);
+            }
+            out
+        })
+        .collect()
+}
+
 /// Flux `phi` of a ray that went through tinted glazing of factor `tint` (the energy it
 /// carries on, per channel), the difference booked to the panes ([`State::tint`]); `phi`
 /// itself for every other ray.

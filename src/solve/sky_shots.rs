@@ -26,7 +26,7 @@
 //! not a winding error).
 
 use super::books::State;
-use super::ray_shots::{carried, Hits, RayCaster, BACK, CHUNK, ESCAPED};
+use super::ray_shots::{carried, cast_free, Hits, RayCaster, BACK, CHUNK, ESCAPED};
 use super::{rng_for, Stream};
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
@@ -179,22 +179,13 @@ pub(super) fn shoot<I: Intersector>(
         st.emit_distant(&phi);
         let chunks: Vec<usize> = (0..x.div_ceil(CHUNK)).collect();
         for batch in chunks.chunks(BATCH_CHUNKS) {
-            let hits: Vec<Hits> = batch
-                .par_iter()
-                .map(|&ch| {
-                    let mut rng = rng_for(seed, Stream::Sky, ((k as u64) << 32) | ch as u64);
-                    let mut out = Hits::default();
-                    for r in ch * CHUNK..(ch * CHUNK + CHUNK).min(x) {
-                        let (org, dir) = piece_ray(piece, bounds, &grid, r, &mut rng);
-                        let (code, tint) = caster.trace(None, org, dir, 0.0, &mut rng);
-                        if let Some(t) = tint {
-                            out.tinted.push((out.codes.len() as u32, t));
-                        }
-                        out.codes.push(code);
-                    }
-                    out
-                })
-                .collect();
+            let hits = cast_free(
+                caster,
+                batch,
+                x,
+                |ch| rng_for(seed, Stream::Sky, ((k as u64) << 32) | ch as u64),
+                |r, rng| piece_ray(piece, bounds, &grid, r, rng),
+            );
             for (code, tint) in hits.iter().flat_map(Hits::iter) {
                 // Through tinted glazing, the ray carries its energy on tinted (books: the
                 // difference is the panes').

@@ -20,6 +20,7 @@ mod grid_rooms;
 mod grid_work_plane;
 mod house_rules;
 mod intersect;
+mod luminaires;
 mod outputs;
 mod relight;
 mod reproducible;

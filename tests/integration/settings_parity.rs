@@ -336,6 +336,7 @@ const SHAPING: &[Shaping] = &[
     shaping("one-sided", &["--one-sided"], &[]),
     shaping("uniform-patches", &["--uniform-patches"], &[]),
     shaping("flip", &["--flip"], &[]),
+    shaping("luminaires", &["--luminaires", "lamps.csv"], &[]),
     shaping("seed", &["--seed", "7"], &[]),
     shaping("tolerance", &["--tolerance", "0.1"], &[]),
     shaping("energy-per-ray", &["--energy-per-ray", "0.5"], &[]),

@@ -46,6 +46,12 @@ pub struct SceneArgs {
     /// away from them).
     #[arg(long)]
     pub flip: bool,
+    /// Luminaires to place in the model: a schedule (CSV or JSON) naming for each its IES or
+    /// EULUMDAT file, position x,y,z, and optionally an aim point, spin, count and step,
+    /// light-loss factor, colour and group (README, "Luminaires"). They shoot first and light
+    /// the final gather, the grid and the picture exactly, by shadow rays.
+    #[arg(long, value_name = "FILE")]
+    pub luminaires: Option<PathBuf>,
 }
 
 impl SceneArgs {
@@ -53,6 +59,8 @@ impl SceneArgs {
         LoadOptions {
             emit: self.emit.clone(),
             flip: self.flip,
+            luminaires: self.luminaires.clone(),
+            zenith: None,
         }
     }
     pub fn mesh(&self) -> MeshOptions {

@@ -147,7 +147,11 @@ impl SolveArgs {
         Ok(SolveJob {
             source: source(self.scene.clone()),
             settings: RunSettings {
-                load: self.scene_args.load(),
+                // The zenith aims the luminaires (recorded only when there are some).
+                load: radiosity::scene::LoadOptions {
+                    zenith: (self.scene_args.luminaires.as_ref()).map(|_| zenith.to_array()),
+                    ..self.scene_args.load()
+                },
                 mesh: self.scene_args.mesh(),
                 solve,
                 intersector: self.solve_args.intersector(),

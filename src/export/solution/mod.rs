@@ -185,6 +185,8 @@ pub enum SolutionError {
         scene: String,
         scene_hash: u64,
     },
+    #[error("{}: its luminaires: {message} (the solution names their schedule, read again on load)", path.display())]
+    Luminaires { path: PathBuf, message: String },
 }
 
 /// FNV-1a, 64 bits: stable across platforms and versions, which is all the hash needs (it
@@ -316,7 +318,32 @@ impl SavedSolution {
             path: path.to_path_buf(),
             source,
         })?;
-        Self::from_bytes(path, &bytes)
+        let mut sol = Self::from_bytes(path, &bytes)?;
+        sol.mesh.luminaires = sol.luminaires(path)?;
+        Ok(sol)
+    }
+
+    /// The luminaires the solve placed (`--luminaires`): the file keeps their schedule's path,
+    /// as given to the solve, and the zenith that aimed them; both are read again here. None
+    /// when the solve had none.
+    fn luminaires(&self, path: &Path) -> Result<Vec<crate::luminaire::Luminaire>, SolutionError> {
+        let load = self.meta.settings.get("load");
+        let Some(schedule) = load
+            .and_then(|l| l.get("luminaires"))
+            .and_then(|v| v.as_str())
+        else {
+            return Ok(Vec::new());
+        };
+        let zenith = (load.and_then(|l| l.get("zenith")))
+            .and_then(|z| serde_json::from_value::<[f32; 3]>(z.clone()).ok())
+            .unwrap_or(crate::sky::DEFAULT_ZENITH.to_array());
+        let zenith = glam::Vec3::from(zenith).as_dvec3();
+        crate::luminaire::read_schedule(Path::new(schedule), zenith).map_err(|e| {
+            SolutionError::Luminaires {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            }
+        })
     }
 
     /// Parses a solution file's bytes; `path` only names it in errors.

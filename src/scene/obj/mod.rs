@@ -35,7 +35,7 @@ use glam::Vec3;
 use mtl::{convert_material, default_grey, load_library, textures_and_clamp, MtlLog, MtlSource};
 use std::cell::RefCell;
 use std::collections::HashSet;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use text::{
     describe_non_finite, describe_obj_error, fmt3, io_reason, name_list, normalize, one_line,
     patch_size_hint, prescan, without_lines,
@@ -51,6 +51,12 @@ pub struct LoadOptions {
     /// Turn every polygon round (`--flip`): for models wound clockwise, whose rooms come out
     /// inside out (docs/design.md §7).
     pub flip: bool,
+    /// A schedule of luminaires placed in the model (`--luminaires FILE`, CSV or JSON:
+    /// [`crate::luminaire::schedule`]), read with the model.
+    pub luminaires: Option<PathBuf>,
+    /// The model's up direction the luminaires are aimed by (a luminaire aims straight down,
+    /// along −zenith, unless its row says otherwise); `None`: [`crate::sky::DEFAULT_ZENITH`].
+    pub zenith: Option<[f32; 3]>,
 }
 
 /// A scene that cannot be loaded. Displays as one line, `"<file>: <what is wrong>"`.
@@ -68,6 +74,16 @@ impl SceneError {
         SceneError {
             path: one_line(path),
             message: one_line(&message.into()),
+        }
+    }
+
+    /// An error already written as one line `"<where>: <what>"` by another reader (the
+    /// luminaires' schedule names its file and line itself), kept as it reads; a line with no
+    /// `": "` is said of `file`.
+    pub(crate) fn from_line(file: &str, line: &str) -> Self {
+        match line.split_once(": ") {
+            Some((at, what)) => SceneError::new(at, what),
+            None => SceneError::new(file, line),
         }
     }
 }
