@@ -27,6 +27,12 @@ pub fn build(job: &SolveJob, model: &Model, log: &mut impl FnMut(&str)) -> Resul
                 g.names.push(lights::SUN_CHANNEL.to_string());
             }
         }
+        // Each luminaire group too (a group named as an emitting material shares its channel).
+        for l in &scene.luminaires {
+            if g.channel(&l.group).is_none() {
+                g.names.push(l.group.clone());
+            }
+        }
         log(&format!(
             "per-light channels: {} ({})",
             g.len(),

@@ -49,6 +49,13 @@ pub fn relight(sol: &SavedSolution, weights: &[(String, f64)]) -> Result<SavedSo
         });
     }
     out.vertex_b = out.mesh.vertex_values(&out.b);
+    // A luminaire's direct light is gathered from the luminaire itself: it is scaled by its
+    // group's weight, so the pictures and elements gathered on `out` see it relit too.
+    for l in &mut out.mesh.luminaires {
+        if let Some(c) = sol.channels.iter().position(|c| c.name == l.group) {
+            l.scale *= w[c];
+        }
+    }
     // The elements' gathered values are the saved lights' ([`relight_with_elements`]).
     out.elements = None;
     Ok(out)
