@@ -1,5 +1,5 @@
 //! The figures daylighting standards quote of a grid: mean, minimum and maximum illuminance,
-//! uniformity U0 = minimum / mean (as EN 12464-1 defines it), the median, and the mean daylight
+//! uniformity U0 = minimum / mean (as EN 12464-1 defines it), Emin / Emax, the median, and the mean daylight
 //! factor, of the whole grid ([`GridStats`]) and of each storey and room ([`GridReport`]).
 //! They go to `summary.json`.
 
@@ -19,6 +19,9 @@ pub struct GridStats {
     pub max_lux: f64,
     /// U0 = min / mean (0 when the mean is 0).
     pub uniformity: f64,
+    /// Emin / Emax, the diversity lighting designers quote beside U0 (0 when the maximum is 0).
+    #[serde(default)]
+    pub min_over_max: f64,
     /// Daylight factor, %.
     pub mean_df: f64,
     /// The middle value (the mean of the two middle values for an even count), lux.
@@ -43,19 +46,25 @@ pub fn stats(lux: &[f64], df: &[f64]) -> GridStats {
             min_lux: 0.0,
             max_lux: 0.0,
             uniformity: 0.0,
+            min_over_max: 0.0,
             mean_df: 0.0,
             median_lux: 0.0,
         };
     }
     let mean_lux = sorted.iter().sum::<f64>() / n as f64;
-    let min_lux = sorted[0];
+    let (min_lux, max_lux) = (sorted[0], sorted[n - 1]);
     GridStats {
         points: n as u64,
         mean_lux,
         min_lux,
-        max_lux: sorted[n - 1],
+        max_lux,
         uniformity: if mean_lux > 0.0 {
             min_lux / mean_lux
+        } else {
+            0.0
+        },
+        min_over_max: if max_lux > 0.0 {
+            min_lux / max_lux
         } else {
             0.0
         },
@@ -194,6 +203,7 @@ mod tests {
                 min_lux: 100.0,
                 max_lux: 500.0,
                 uniformity: 100.0 / 275.0,
+                min_over_max: 100.0 / 500.0,
                 mean_df: 2.75,
                 median_lux: 250.0,
             }
@@ -211,6 +221,9 @@ mod tests {
             (0, 0.0, 0.0, 0.0)
         );
         let dark = stats(&[0.0, 0.0], &[0.0, 0.0]);
-        assert_eq!((dark.points, dark.uniformity), (2, 0.0));
+        assert_eq!(
+            (dark.points, dark.uniformity, dark.min_over_max),
+            (2, 0.0, 0.0)
+        );
     }
 }

@@ -46,7 +46,7 @@ pub fn measure_grid(
     let g = measure(job, spec, solved, isect, &frame).map_err(|e| Error::Invalid(e.to_string()))?;
     let (seconds, cpu_seconds) = (clock.seconds(), clock.cpu_seconds());
     let plan = grid::plan_image(&g.sensors, &g.lux, &frame, spec.spacing_hint(), PLAN_WIDTH);
-    for line in lines(&g.stats) {
+    for line in lines(&g.stats, job.settings.solve.sky.is_some()) {
         log(&line);
     }
     if let Some(w) = &g.warning {
@@ -60,13 +60,18 @@ pub fn measure_grid(
     }))
 }
 
-/// What the log says of a grid: its figures, the outdoor sensors, and one short line per
-/// storey and per room when there are several.
-fn lines(r: &GridReport) -> Vec<String> {
+/// What the log says of a grid: its figures (the daylight factor under a sky), the outdoor
+/// sensors, and one short line per storey and per room when there are several.
+fn lines(r: &GridReport, daylit: bool) -> Vec<String> {
     let figures = |s: &GridStats| {
+        let df = if daylit {
+            format!(", mean daylight factor {:.2} %", s.mean_df)
+        } else {
+            String::new()
+        };
         format!(
-            "mean {:.0} lux, min {:.0} lux, uniformity {:.2}, mean daylight factor {:.2} %",
-            s.mean_lux, s.min_lux, s.uniformity, s.mean_df
+            "mean {:.0} lux, min {:.0} lux, max {:.0} lux, U0 {:.2}, Emin/Emax {:.2}{df}",
+            s.mean_lux, s.min_lux, s.max_lux, s.uniformity, s.min_over_max
         )
     };
     let mut out = vec![format!(
