@@ -36,6 +36,11 @@ pub struct LuminaireInfo {
     pub position: [f64; 3],
     /// Where it aims (γ = 0), a unit direction.
     pub aim: [f64; 3],
+    /// Its C0 plane's direction (the luminaire's length), unit, perpendicular to `aim`.
+    pub c0: [f64; 3],
+    /// What its web is multiplied by (light-loss factor × count) and its tint (luminance 1).
+    pub scale: f64,
+    pub colour: [f64; 3],
     /// Luminous flux, lm: the web's × light-loss factor × count × tilt factor.
     pub lumens: f64,
     /// Radiant flux per channel at 179 lm/W, W.
@@ -51,6 +56,9 @@ pub fn luminaires(scene: &Scene) -> Vec<LuminaireInfo> {
             file: l.file.display().to_string(),
             position: l.position.to_array(),
             aim: l.frame.aim.to_array(),
+            c0: l.frame.c0.to_array(),
+            scale: l.scale * l.tilt_factor,
+            colour: l.colour,
             lumens: l.flux_lumens(),
             watts: l.flux_watts(),
         })
