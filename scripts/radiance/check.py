@@ -160,11 +160,28 @@ class Radiance:
         self.cpu_seconds = 0.0
         self.rays = 0
         self.sources = {}
+        # Scene files added to every octree (the luminaires of --luminaires).
+        self.extra = []
 
     def octree(self, model, name, light_radiance=None):
         rad = self.workdir / f"{name}.rad"
         self.sources = objrad.write_rad(model, rad, light_radiance)
-        return oconv(self.bin, self.env, [rad], self.workdir / f"{name}.oct")
+        return oconv(self.bin, self.env, [rad, *self.extra], self.workdir / f"{name}.oct")
+
+    def add_luminaires(self, binary: Path, model: Path, solve_args: list[str]):
+        """The luminaires a solve's ``--luminaires SCHEDULE`` places, as Radiance sources in
+        every octree (``luminaires.luminaire_rad``: ies2rad, turned into the tool's frame)."""
+        if "--luminaires" not in solve_args:
+            return
+        schedule = solve_args[solve_args.index("--luminaires") + 1]
+        from luminaires import luminaire_rad
+        info = json.loads(run([binary, "info", "--json", model, "--luminaires",
+                               schedule]).stdout)
+        text = "".join(luminaire_rad(self.bin, self.env, lum, k, self.workdir)
+                       for k, lum in enumerate(info["luminaires"]))
+        path = self.workdir / "luminaires.rad"
+        path.write_text(text)
+        self.extra = [path]
 
     def irradiance(self, octree: Path, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
         """RGB irradiance at each origin on a surface facing dirs."""
@@ -526,6 +543,7 @@ def main():
     # Radiance, or its saved result for the same model, points and settings (--reuse).
     model = objrad.read_obj(model_path, binary, parse_emit(arg_sets[0]))
     rad = Radiance(args, out)
+    rad.add_luminaires(binary, model_path, arg_sets[0])
     key = {"model": str(model_path), "bytes": model_path.stat().st_size,
            "mtime": model_path.stat().st_mtime, "rtrace": " ".join(rad.opts),
            "ids": [int(i) for i in ids], "points": args.points, "seed": args.seed,
