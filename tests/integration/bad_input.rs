@@ -68,6 +68,14 @@ const FILES: &[Case] = &[
     ("bad index after continued lines", "solve -q {c}/continued-lines-then-bad-index.obj --out {t}/o", &["continued-lines-then-bad-index.obj", "line 13", "vertex 99", "has 6 vertices"]),
     ("face of 2 vertices and a comment", "solve -q {c}/trailing-comment-then-bad-face.obj --out {t}/o", &["trailing-comment-then-bad-face.obj", "line 4", "a face with 2 vertices"]),
     ("info reads the same way", "info {c}/face-index-zero.obj", &["face-index-zero.obj", "index 0"]),
+    // Luminaire schedules (`--luminaires`) and photometric files.
+    ("schedule without a z column", "solve -q {c}/lit.obj --luminaires {c}/schedule-missing-z.csv --out {t}/o", &["schedule-missing-z.csv:1", "missing column 'z'"]),
+    ("schedule with a word for a number", "solve -q {c}/lit.obj --luminaires {c}/schedule-bad-number.csv --out {t}/o", &["schedule-bad-number.csv:3", "'x' is not a finite number"]),
+    ("schedule naming a missing IES file", "solve -q {c}/lit.obj --luminaires {c}/schedule-missing-ies.csv --out {t}/o", &["schedule-missing-ies.csv:2", "no-such-lamp.ies", "cannot read"]),
+    ("schedule naming a garbled IES file", "solve -q {c}/lit.obj --luminaires {c}/schedule-garbage-ies.csv --out {t}/o", &["schedule-garbage-ies.csv:2", "garbage-web.ies:4", "vertical angles"]),
+    ("schedule with no luminaire", "solve -q {c}/lit.obj --luminaires {c}/schedule-empty.csv --out {t}/o", &["schedule-empty.csv", "no luminaires"]),
+    ("JSON schedule with an unknown key", "solve -q {c}/lit.obj --luminaires {c}/schedule-unknown-key.json --out {t}/o", &["schedule-unknown-key.json:1", "unknown field `brightness`"]),
+    ("info of a garbled IES file", "info {c}/garbage-web.ies", &["garbage-web.ies:4", "vertical angles"]),
     // Generated here rather than committed (the repository stays small).
     ("an extremely long line", "solve -q {s}/long-line.obj --out {t}/o", &["long-line.obj", "vertex 3 (line 3)", "not finite"]),
     ("10^6 zero-area faces", "solve -q {s}/million-faces.obj --out {t}/o", &["million-faces.obj", "all 1000000 faces have zero area"]),
@@ -316,7 +324,10 @@ fn every_corpus_file_is_used() {
         let stem = name
             .trim_end_matches(".png")
             .trim_end_matches(".mtl")
-            .trim_end_matches(".obj");
+            .trim_end_matches(".obj")
+            .trim_end_matches(".csv")
+            .trim_end_matches(".json")
+            .trim_end_matches(".ies");
         assert!(used.contains(stem), "{name} is in no case");
     }
     assert!(FILES.len() >= 30, "the corpus has {} cases", FILES.len());
