@@ -59,7 +59,7 @@ pub fn plan_image(
         let colour = colour_at(scale.t(super::csv::finite(lux[k])));
         fill(&mut img, layout.cell(local[k], storey[k]), colour);
     }
-    layout.draw_labels(&mut img, &local, &storey);
+    layout.draw_labels(&mut img, &local, &storey, lux);
     draw_north(&mut img, layout.font, layout.top);
     false_colour::draw_legend(&mut img, layout.width, &scale, "lux");
     img
@@ -158,16 +158,35 @@ impl Layout {
         ]
     }
 
-    /// Each panel's height label: its lowest sensors, "+0.8 m".
-    fn draw_labels(&self, img: &mut image::RgbImage, local: &[DVec3], storey: &[u32]) {
-        let mut lowest = vec![f64::INFINITY; self.panel_x.len()];
-        for (p, &s) in local.iter().zip(storey) {
+    /// Each panel's label: the height of its lowest sensors, "+0.8 m", then, where the panel
+    /// is wide enough, its figures as a lighting designer reads them: "Eav 540 lx U0 0.15
+    /// Emin/Emax 0.05" (or the first two alone).
+    fn draw_labels(&self, img: &mut image::RgbImage, local: &[DVec3], storey: &[u32], lux: &[f64]) {
+        let n = self.panel_x.len();
+        let mut lowest = vec![f64::INFINITY; n];
+        let mut values = vec![Vec::new(); n];
+        for ((p, &s), &e) in local.iter().zip(storey).zip(lux) {
             lowest[s as usize] = lowest[s as usize].min(p.z);
+            values[s as usize].push(super::csv::finite(e));
         }
-        for (x, z) in self.panel_x.iter().zip(lowest) {
-            if z.is_finite() {
-                glyphs::draw(img, *x, MARGIN, self.font, &format!("{z:+.1} m"), INK);
+        for ((x, z), v) in self.panel_x.iter().zip(lowest).zip(&values) {
+            if !z.is_finite() {
+                continue;
             }
+            let s = super::stats::stats(v, &vec![0.0; v.len()]);
+            let height = format!("{z:+.1} m");
+            let mean = format!("  Eav {:.0} lx  U0 {:.2}", s.mean_lux, s.uniformity);
+            let ratio = format!("  Emin/Emax {:.2}", s.min_over_max);
+            let fits = |t: &str| (glyphs::width(t) * self.font) as i64 <= self.panel_w;
+            let label = [
+                height.clone() + &mean + &ratio,
+                height.clone() + &mean,
+                height,
+            ]
+            .into_iter()
+            .find(|t| fits(t))
+            .unwrap_or_default();
+            glyphs::draw(img, *x, MARGIN, self.font, &label, INK);
         }
     }
 }

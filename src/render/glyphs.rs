@@ -1,5 +1,6 @@
 //! A tiny built-in bitmap font for the labels of image legends: digits and the few letters
-//! numbers and their units need (`.`, `-`, `+`, `k`, `W`, `/`, `m`, `lux`, and `N` for north),
+//! numbers and their units need (`.`, `-`, `+`, `k`, `W`, `/`, `m`, `lux`, `N` for north, and
+//! `E`, `U`, `a`, `v`, `i`, `n` for the grid's figures),
 //! 5 pixels high. Enough to label a
 //! colour scale without a font file or a text-rendering crate.
 
@@ -28,6 +29,13 @@ fn glyph(c: char) -> Option<[&'static str; 5]> {
         'x' => ["...", "#.#", ".#.", ".#.", "#.#"],
         '+' => ["...", ".#.", "###", ".#.", "..."],
         'N' => ["#...#", "##..#", "#.#.#", "#..##", "#...#"],
+        // The grid's figures: "Eav 540 lx U0 0.15 Emin/Emax 0.05".
+        'E' => ["###", "#..", "##.", "#..", "###"],
+        'U' => ["#.#", "#.#", "#.#", "#.#", "###"],
+        'a' => ["...", "##.", "..#", "###", "###"],
+        'v' => ["...", "#.#", "#.#", "#.#", ".#."],
+        'i' => ["#", ".", "#", "#", "#"],
+        'n' => ["...", "##.", "#.#", "#.#", "#.#"],
         ' ' => ["..", "..", "..", "..", ".."],
         _ => return None,
     })
