@@ -10,7 +10,7 @@ use radiosity::solve::SolveSettings;
 use std::f64::consts::PI;
 use std::path::Path;
 
-use crate::common::{run, solve_mesh};
+use crate::common::{on_threads, run, solve_mesh};
 use crate::scene_builder::{closed_box, material, mesh_at};
 
 /// An isotropic web: one plane, γ 0..180 by 5°, `cd` candela.
@@ -247,4 +247,27 @@ fn relighting_a_luminaire_group_matches_a_solve_without_it() {
         b > 0.0 && (a / b - 1.0).abs() < 0.01,
         "relit {a} against {b}"
     );
+}
+
+/// The luminaires' shots and gathers draw their random numbers by (seed, luminaire, chunk) and
+/// (seed, patch): the same radiosities, bit for bit, on 1 and 2 threads.
+#[test]
+fn a_solve_with_luminaires_is_the_same_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(d, "asym.ies", &asymmetric());
+    write(d, "iso.ies", &isotropic(500.0));
+    write(
+        d,
+        "lum.csv",
+        "file,x,y,z,count,step_x\nasym.ies,0.5,3.5,1,3,1.2\niso.ies,2,1,3,1,0\n",
+    );
+    let mut scene = closed_box(4.0, 4.0, 4.0, material("box", 0.6, 0.0));
+    scene.luminaires = read_schedule(&d.join("lum.csv"), glam::DVec3::Y).unwrap();
+    let m = mesh_at(&scene, Some(0.4));
+    let cfg = SolveSettings::default();
+    let one = on_threads(Some(1), || solve_mesh(&scene, &m, &cfg));
+    let two = on_threads(Some(2), || solve_mesh(&scene, &m, &cfg));
+    assert_eq!(one.b, two.b);
+    assert!(one.b.iter().any(|b| b[1] > 0.0));
 }
