@@ -86,7 +86,7 @@ pub enum ScheduleError {
         source: PhotometryError,
     },
     /// The schedule lists no luminaire.
-    #[error("no luminaires in {file}")]
+    #[error("{file}: no luminaires listed")]
     Empty { file: String },
     /// The zenith given with the schedule is not a direction.
     #[error("{file}: the zenith is not a direction (zero or not finite)")]

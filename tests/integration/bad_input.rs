@@ -73,7 +73,7 @@ const FILES: &[Case] = &[
     ("schedule with a word for a number", "solve -q {c}/lit.obj --luminaires {c}/schedule-bad-number.csv --out {t}/o", &["schedule-bad-number.csv:3", "'x' is not a finite number"]),
     ("schedule naming a missing IES file", "solve -q {c}/lit.obj --luminaires {c}/schedule-missing-ies.csv --out {t}/o", &["schedule-missing-ies.csv:2", "no-such-lamp.ies", "cannot read"]),
     ("schedule naming a garbled IES file", "solve -q {c}/lit.obj --luminaires {c}/schedule-garbage-ies.csv --out {t}/o", &["schedule-garbage-ies.csv:2", "garbage-web.ies:4", "vertical angles"]),
-    ("schedule with no luminaire", "solve -q {c}/lit.obj --luminaires {c}/schedule-empty.csv --out {t}/o", &["schedule-empty.csv", "no luminaires"]),
+    ("schedule with no luminaire", "solve -q {c}/lit.obj --luminaires {c}/schedule-empty.csv --out {t}/o", &["schedule-empty.csv: no luminaires listed"]),
     ("JSON schedule with an unknown key", "solve -q {c}/lit.obj --luminaires {c}/schedule-unknown-key.json --out {t}/o", &["schedule-unknown-key.json:1", "unknown field `brightness`"]),
     ("info of a garbled IES file", "info {c}/garbage-web.ies", &["garbage-web.ies:4", "vertical angles"]),
     // Generated here rather than committed (the repository stays small).
