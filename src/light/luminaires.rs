@@ -41,9 +41,7 @@ pub fn unoccluded(l: &Luminaire, x: Vec3, n: Vec3) -> Option<(Rgb, Vec3, f32)> {
     }
     let i = Rgb::from_array(l.intensity_toward(-d));
     let e = i * (cos / r2);
-    (scalar(e) > 0.0)
-        .then(|| ((d / r).as_vec3(), r as f32))
-        .map(|(dir, r)| (e, dir, r))
+    (scalar(e) > 0.0).then(|| (e, (d / r).as_vec3(), r as f32))
 }
 
 impl<I: Intersector> Kernel<'_, I> {

@@ -52,6 +52,8 @@ pub struct Luminaire {
     pub file: PathBuf,
     /// The web, shared by every luminaire of the same file.
     pub photometry: Arc<Photometry>,
+    /// The web's own lumens (`Photometry::total_lumens`, integrated once when it was read).
+    pub web_lumens: f64,
     /// Where it is: the photometric centre, model coordinates.
     pub position: DVec3,
     /// How it is turned.
@@ -78,9 +80,8 @@ impl Luminaire {
     }
 
     /// The luminaire's luminous flux, lumens: the web's total lumens × scale × tilt factor.
-    /// Integrates the web afresh (some 65 000 intensity look-ups): call it once, not per ray.
     pub fn flux_lumens(&self) -> f64 {
-        self.photometry.total_lumens() * self.scale * self.tilt_factor
+        self.web_lumens * self.scale * self.tilt_factor
     }
 
     /// The luminaire's radiant flux per RGB channel, W: [`Luminaire::flux_lumens`] /

@@ -218,7 +218,8 @@ struct Placer<'a> {
     folder: &'a Path,
     zenith: DVec3,
     /// Every web read so far, by resolved path.
-    webs: HashMap<PathBuf, Arc<Photometry>>,
+    /// Each photometric file read so far: its web and the web's lumens (integrated once).
+    webs: HashMap<PathBuf, (Arc<Photometry>, f64)>,
 }
 
 impl Placer<'_> {
@@ -236,7 +237,7 @@ impl Placer<'_> {
                 "aim point {point} is the luminaire's position: it gives no direction"
             ))
         })?;
-        let (path, photometry) = self.web(row)?;
+        let (path, photometry, web_lumens) = self.web(row)?;
         let name = row.name.clone().unwrap_or_else(|| default_name(row));
         let group = row.group.clone().unwrap_or_else(|| name.clone());
         let count = row.count as u64;
@@ -257,6 +258,7 @@ impl Placer<'_> {
                 group: group.clone(),
                 file: path.clone(),
                 photometry: photometry.clone(),
+                web_lumens,
                 position: row.position + row.step * k as f64,
                 frame,
                 scale,
@@ -267,11 +269,12 @@ impl Placer<'_> {
         Ok(())
     }
 
-    /// The web of `row`'s photometric file, read on first use; it must carry light.
-    fn web(&mut self, row: &Row) -> Result<(PathBuf, Arc<Photometry>), ScheduleError> {
+    /// The web of `row`'s photometric file and its lumens, read on first use; it must carry
+    /// light.
+    fn web(&mut self, row: &Row) -> Result<(PathBuf, Arc<Photometry>, f64), ScheduleError> {
         let path = self.folder.join(&row.file);
-        if let Some(web) = self.webs.get(&path) {
-            return Ok((path, web.clone()));
+        if let Some((web, lumens)) = self.webs.get(&path) {
+            return Ok((path, web.clone(), *lumens));
         }
         let web = photometry::read(&path).map_err(|source| ScheduleError::Photometry {
             file: self.file.to_string(),
@@ -284,8 +287,8 @@ impl Placer<'_> {
             return Err(invalid(self.file, row.line, m));
         }
         let web = Arc::new(web);
-        self.webs.insert(path.clone(), web.clone());
-        Ok((path, web))
+        self.webs.insert(path.clone(), (web.clone(), lumens));
+        Ok((path, web, lumens))
     }
 }
 

@@ -1,38 +1,12 @@
 //! Tests of the equal-flux cells: each checks the sampler against the web through
 //! `Photometry::intensity` integrated independently (midpoint rule), never through the table.
 
+use super::super::test_webs::{ies, steps};
 use super::super::{parse_ies, parse_ldt, PhotometricType, Photometry};
 use super::{CellAngles, FluxCells};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
-
-/// An LM-63-2002 file of photometric type `kind` (1 = C, 2 = B, 3 = A), read back.
-fn ies(kind: u8, vertical: &[f64], horizontal: &[f64], planes: &[Vec<f64>]) -> Photometry {
-    let join = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{x}"))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
-    let mut text = format!(
-        "IESNA:LM-63-2002\n[TEST] cells\nTILT=NONE\n1 -1 1 {} {} {kind} 2 0 0 0\n1 1 0\n{}\n{}\n",
-        vertical.len(),
-        horizontal.len(),
-        join(vertical),
-        join(horizontal)
-    );
-    for p in planes {
-        text.push_str(&join(p));
-        text.push('\n');
-    }
-    parse_ies(&text, "cells.ies").unwrap()
-}
-
-fn steps(lo: f64, hi: f64, step: f64) -> Vec<f64> {
-    let n = ((hi - lo) / step).round() as usize;
-    (0..=n).map(|k| lo + step * k as f64).collect()
-}
 
 /// The web of `kind` whose candela at (horizontal h, vertical v) is `f(h, v)`.
 fn web(kind: u8, vertical: &[f64], horizontal: &[f64], f: impl Fn(f64, f64) -> f64) -> Photometry {

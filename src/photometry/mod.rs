@@ -30,6 +30,8 @@ pub mod cells;
 mod eulumdat;
 mod ies;
 pub mod summary;
+#[cfg(test)]
+mod test_webs;
 mod web;
 
 pub use eulumdat::parse_ldt;

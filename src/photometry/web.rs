@@ -295,36 +295,9 @@ impl Tilt {
 
 #[cfg(test)]
 mod tests {
-    use super::super::parse_ies;
+    use super::super::test_webs::{ies, steps};
     use super::*;
     use std::f64::consts::PI;
-
-    /// An LM-63-2002 Type `kind` file (1 = C, 2 = B) of the given angles and candela planes.
-    fn ies(kind: u8, vertical: &[f64], horizontal: &[f64], planes: &[Vec<f64>]) -> Photometry {
-        let join = |v: &[f64]| {
-            v.iter()
-                .map(|x| format!("{x}"))
-                .collect::<Vec<_>>()
-                .join(" ")
-        };
-        let mut text = format!(
-            "IESNA:LM-63-2002\n[TEST] web\nTILT=NONE\n1 -1 1 {} {} {kind} 2 0 0 0\n1 1 0\n{}\n{}\n",
-            vertical.len(),
-            horizontal.len(),
-            join(vertical),
-            join(horizontal)
-        );
-        for p in planes {
-            text.push_str(&join(p));
-            text.push('\n');
-        }
-        parse_ies(&text, "web.ies").unwrap()
-    }
-
-    fn steps(lo: f64, hi: f64, step: f64) -> Vec<f64> {
-        let n = ((hi - lo) / step).round() as usize;
-        (0..=n).map(|k| lo + step * k as f64).collect()
-    }
 
     /// A quadrant web: C 0, 45, 90; γ 0, 45, 90; distinct values everywhere.
     fn quadrant() -> Photometry {
