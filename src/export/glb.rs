@@ -226,6 +226,7 @@ fn push_scene(root: &mut json::Root, primitive: Primitive) {
         },
         extensions: Some(json::extensions::material::Material {
             unlit: Some(json::extensions::material::Unlit {}),
+            ..Default::default()
         }),
         ..Default::default()
     });

@@ -63,6 +63,7 @@ pub struct RunSettings {
 impl RunSettings {
     /// Checks every setting a user can get wrong (one line naming the flag).
     pub fn check(&self) -> Result<(), Invalid> {
+        self.load.check()?;
         self.mesh.check()?;
         self.elements.check()?;
         self.solve.check()
@@ -295,6 +296,7 @@ pub fn info(
     load: &LoadOptions,
     mesh_opts: &MeshOptions,
 ) -> Result<report::SceneInfo, Error> {
+    load.check()?;
     let mut model = Model::load(source, load, mesh_opts)?;
     // The hidden sides need rays: Embree (or the plane merge) over the patches, as a solve's.
     let (isect, _) = model.intersector(IntersectorKind::default())?;

@@ -7,10 +7,12 @@
 //! Radiance read it, so a Lambertian emitter's radiosity is E = π·Ke (W/m²).
 
 mod default;
+pub mod gltf;
 mod obj;
 pub mod sides;
 
 pub use default::{default_scene, DEFAULT_SCENE_MTL, DEFAULT_SCENE_NAME, DEFAULT_SCENE_OBJ};
+pub use gltf::{is_gltf, load_gltf, load_gltf_from_slice};
 pub use obj::{load_obj, load_obj_from_strs, LoadOptions, SceneError};
 
 use glam::Vec3;
@@ -33,13 +35,21 @@ impl SceneSource {
         path.map_or(SceneSource::Default, SceneSource::File)
     }
 
-    /// Loads the scene.
-    /// Loads the scene, and the luminaires' schedule when the options name one.
+    /// Loads the scene (OBJ, or glTF by the file's extension `.gltf`/`.glb`), scales it by
+    /// `--scale` (its lights too), warns of a size implausible for a building, and reads the
+    /// luminaires' schedule when the options name one.
     pub fn load(&self, opts: &LoadOptions) -> Result<Scene, SceneError> {
         let mut scene = match self {
             SceneSource::Default => default_scene(opts),
+            SceneSource::File(p) if is_gltf(p) => load_gltf(p, opts),
             SceneSource::File(p) => load_obj(p, opts),
         }?;
+        if let Some(s) = opts.scale.filter(|s| *s != 1.0) {
+            scene.scale(s);
+        }
+        if let Some(w) = size_warning(&scene, opts.scale) {
+            scene.warnings.push(w);
+        }
         if let Some(path) = &opts.luminaires {
             let zenith = Vec3::from(opts.zenith.unwrap_or(crate::sky::DEFAULT_ZENITH.to_array()));
             scene.luminaires = crate::luminaire::read_schedule(path, zenith.as_dvec3())
@@ -47,6 +57,43 @@ impl SceneSource {
         }
         Ok(scene)
     }
+}
+
+/// A model wider than this (metres, its largest extent) is implausible for a building: a
+/// warning names `--scale` (an export in millimetres of a 6 m room is 6,000 units across).
+pub const MAX_PLAUSIBLE_SIZE: f64 = 3_000.0;
+
+/// The warning for a model whose largest extent is above [`MAX_PLAUSIBLE_SIZE`], naming the
+/// scale that would make it metres if it is in millimetres, centimetres or inches.
+fn size_warning(scene: &Scene, scale: Option<f64>) -> Option<String> {
+    let (lo, hi) = scene.bounds();
+    let size = f64::from((hi - lo).max_element());
+    if size <= MAX_PLAUSIBLE_SIZE {
+        return None;
+    }
+    let given = match scale {
+        Some(s) => format!(" after --scale {s}"),
+        None => String::new(),
+    };
+    Some(format!(
+        "{}: the model is {size:.0} m across{given}, implausible for a building: if its units \
+         are not metres give --scale (0.001 for millimetres, 0.01 for centimetres, 0.0254 for \
+         inches)",
+        scene.name
+    ))
+}
+
+/// A sun given by the model itself (a glTF directional light), used when no `--sun` is given.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelSun {
+    /// The light's name, for messages.
+    pub name: String,
+    /// Unit vector from the model towards the sun.
+    pub towards: glam::DVec3,
+    /// Illuminance on a plane facing the sun, lux.
+    pub illuminance: f64,
+    /// Whether the light is white (the tool's sun is: a colour is left out, with a warning).
+    pub white: bool,
 }
 
 /// The largest reflectance a material is given: an MTL `Kd` (or `Kd` × texture) of 1 or more
@@ -195,6 +242,8 @@ pub struct Scene {
     /// Luminaires placed in the model by a schedule (`--luminaires`): point sources with a
     /// photometric web, shot first and gathered exactly ([`crate::luminaire`]).
     pub luminaires: Vec<crate::luminaire::Luminaire>,
+    /// The model's own sun (a glTF directional light), if it has one.
+    pub sun: Option<ModelSun>,
 }
 
 impl Scene {
@@ -216,6 +265,17 @@ impl Scene {
             (Vec3::ZERO, Vec3::ZERO)
         } else {
             (lo, hi)
+        }
+    }
+
+    /// Multiplies every position by `s` (`--scale`), and the positions of the model's own
+    /// luminaires (a schedule read after is in metres already).
+    pub fn scale(&mut self, s: f64) {
+        for p in &mut self.positions {
+            *p = (p.as_dvec3() * s).as_vec3();
+        }
+        for l in &mut self.luminaires {
+            l.position *= s;
         }
     }
 

@@ -52,6 +52,12 @@ pub struct SceneArgs {
     /// the final gather, the grid and the picture exactly, by shadow rays.
     #[arg(long, value_name = "FILE")]
     pub luminaires: Option<PathBuf>,
+    /// Multiply the model's coordinates by this to make metres: 0.001 for a model in
+    /// millimetres, 0.01 in centimetres, 0.0254 in inches (a model far too large for a
+    /// building gets a warning naming this flag). Its own lights move with it; a
+    /// --luminaires schedule is in metres.
+    #[arg(long, value_name = "FACTOR", allow_negative_numbers = true)]
+    pub scale: Option<f64>,
 }
 
 impl SceneArgs {
@@ -61,6 +67,7 @@ impl SceneArgs {
             flip: self.flip,
             luminaires: self.luminaires.clone(),
             zenith: None,
+            scale: self.scale,
         }
     }
     pub fn mesh(&self) -> MeshOptions {

@@ -28,18 +28,20 @@ mod mtl;
 #[cfg(test)]
 mod tests;
 mod text;
-mod texture;
+pub(super) mod texture;
 
 use super::{Material, Polygon, Scene};
 use glam::Vec3;
-use mtl::{convert_material, default_grey, load_library, textures_and_clamp, MtlLog, MtlSource};
+pub(super) use mtl::{clamp_and_glazing, default_grey};
+use mtl::{convert_material, load_library, textures_and_clamp, MtlLog, MtlSource};
 use std::cell::RefCell;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use text::{
-    describe_non_finite, describe_obj_error, fmt3, io_reason, name_list, normalize, one_line,
-    patch_size_hint, prescan, without_lines,
+    describe_non_finite, describe_obj_error, fmt3, name_list, normalize, patch_size_hint, prescan,
+    without_lines,
 };
+pub(super) use text::{io_reason, one_line};
 
 /// Options for loading a scene.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -57,6 +59,21 @@ pub struct LoadOptions {
     /// The model's up direction the luminaires are aimed by (a luminaire aims straight down,
     /// along −zenith, unless its row says otherwise); `None`: [`crate::sky::DEFAULT_ZENITH`].
     pub zenith: Option<[f32; 3]>,
+    /// `--scale`: what the model's coordinates are multiplied by to make metres (0.001 for a
+    /// model in millimetres); `None`: 1. The luminaires' schedule is in metres, unscaled.
+    pub scale: Option<f64>,
+}
+
+impl LoadOptions {
+    /// Checks the settings a user can get wrong (one line naming the flag).
+    pub fn check(&self) -> Result<(), crate::settings::Invalid> {
+        match self.scale {
+            Some(s) if !(s.is_finite() && s > 0.0) => crate::settings::Invalid::err(format!(
+                "--scale: the factor {s} is not a finite, positive number"
+            )),
+            _ => Ok(()),
+        }
+    }
 }
 
 /// A scene that cannot be loaded. Displays as one line, `"<file>: <what is wrong>"`.
@@ -70,7 +87,7 @@ pub struct SceneError {
 }
 
 impl SceneError {
-    fn new(path: &str, message: impl Into<String>) -> Self {
+    pub(super) fn new(path: &str, message: impl Into<String>) -> Self {
         SceneError {
             path: one_line(path),
             message: one_line(&message.into()),
@@ -89,7 +106,7 @@ impl SceneError {
 }
 
 /// A face is dropped when its area is below this fraction of the squared scene diagonal.
-const ZERO_AREA: f64 = 1e-12;
+pub(super) const ZERO_AREA: f64 = 1e-12;
 
 /// Load an OBJ file and the MTL libraries it names (looked up beside it).
 ///
@@ -292,7 +309,10 @@ fn check_geometry(
 }
 
 /// The emission overrides (`--emit`): sets `Ke` of every material of each given name.
-fn apply_emit(materials: &mut [Material], emit: &[(String, [f64; 3])]) -> Result<(), String> {
+pub(super) fn apply_emit(
+    materials: &mut [Material],
+    emit: &[(String, [f64; 3])],
+) -> Result<(), String> {
     for (material, ke) in emit {
         if ke.iter().any(|k| !k.is_finite() || *k < 0.0) {
             return Err(format!(

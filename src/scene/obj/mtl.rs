@@ -200,7 +200,17 @@ pub(super) fn textures_and_clamp(
             list(&failed)
         ));
     }
+    clamp_and_glazing(name, materials, warnings);
+}
 
+/// Every reflectance channel of 1 or more clamped to [`MAX_REFLECTANCE`] (one warning naming
+/// the materials), then glazing that would give back more than it receives made to transmit
+/// less ([`glazing`]).
+pub(in crate::scene) fn clamp_and_glazing(
+    name: &str,
+    materials: &mut [Material],
+    warnings: &mut Vec<String>,
+) {
     let mut clamped = Vec::new();
     for m in materials.iter_mut() {
         if m.rho.iter().any(|r| *r >= 1.0) {
@@ -270,7 +280,7 @@ fn list(items: &[String]) -> String {
 }
 
 /// The material of faces without one: grey, named "default" unless the library has that name.
-pub(super) fn default_grey(materials: &[Material]) -> Material {
+pub(in crate::scene) fn default_grey(materials: &[Material]) -> Material {
     let taken = |n: &str| materials.iter().any(|m| m.name == n);
     let name = if taken("default") {
         "default-grey"

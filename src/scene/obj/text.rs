@@ -272,7 +272,7 @@ pub(super) fn snippet(line: &str) -> String {
     }
 }
 
-pub(super) fn one_line(s: &str) -> String {
+pub(in crate::scene) fn one_line(s: &str) -> String {
     if s.contains(['\n', '\r']) {
         s.split(['\n', '\r'])
             .filter(|part| !part.is_empty())
@@ -283,7 +283,7 @@ pub(super) fn one_line(s: &str) -> String {
     }
 }
 
-pub(super) fn io_reason(e: &std::io::Error) -> String {
+pub(in crate::scene) fn io_reason(e: &std::io::Error) -> String {
     match e.kind() {
         std::io::ErrorKind::NotFound => "no such file".into(),
         std::io::ErrorKind::PermissionDenied => "permission denied".into(),

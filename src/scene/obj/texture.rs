@@ -101,6 +101,19 @@ pub(super) fn mean_colours(paths: &[PathBuf]) -> HashMap<PathBuf, Result<[f64; 3
 pub(super) fn mean_colour(path: &Path) -> Result<[f64; 3], String> {
     let reader = image::ImageReader::open(path).map_err(|e| io_reason(&e))?;
     let reader = reader.with_guessed_format().map_err(|e| io_reason(&e))?;
+    mean_of(reader)
+}
+
+/// The mean colour of an image file's bytes (a glTF's embedded image) in linear light.
+pub(in crate::scene) fn mean_colour_of_bytes(bytes: &[u8]) -> Result<[f64; 3], String> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes));
+    mean_of(reader.with_guessed_format().map_err(|e| io_reason(&e))?)
+}
+
+/// The mean colour of what `reader` decodes, in linear light.
+fn mean_of<R: std::io::BufRead + std::io::Seek>(
+    reader: image::ImageReader<R>,
+) -> Result<[f64; 3], String> {
     let image = reader
         .decode()
         .map_err(|e| format!("cannot decode it ({e})"))?;
