@@ -14,6 +14,7 @@
 
 use super::data::{describe, read_uri, Buffers};
 use crate::scene::obj::texture::mean_colour_of_bytes;
+use crate::scene::obj::to_f64;
 use crate::scene::{Material, RhoSource};
 use std::collections::HashMap;
 use std::path::Path;
@@ -60,7 +61,7 @@ fn material(m: &gltf::Material, images: &mut Images) -> Result<Material, String>
         .map(str::to_string)
         .unwrap_or_else(|| format!("material{index}"));
     let pbr = m.pbr_metallic_roughness();
-    let factor = pbr.base_color_factor().map(f64::from);
+    let factor = pbr.base_color_factor().map(to_f64);
     let base = [factor[0], factor[1], factor[2]];
     check(&label, "base colour", &factor)?;
     let (colour, rho_source) = match pbr.base_color_texture() {
@@ -78,7 +79,7 @@ fn material(m: &gltf::Material, images: &mut Images) -> Result<Material, String>
         None => (base, RhoSource::Kd),
     };
     let (t, tinted) = match m.transmission() {
-        Some(tr) => (f64::from(tr.transmission_factor()), true),
+        Some(tr) => (to_f64(tr.transmission_factor()), true),
         None if m.alpha_mode() == gltf::material::AlphaMode::Blend && factor[3] < 1.0 => {
             (1.0 - factor[3], false)
         }
@@ -93,8 +94,8 @@ fn material(m: &gltf::Material, images: &mut Images) -> Result<Material, String>
     };
     let mean_t = transmitted.iter().sum::<f64>() / 3.0;
     let grey = transmitted[0] == transmitted[1] && transmitted[1] == transmitted[2];
-    let strength = f64::from(m.emissive_strength().unwrap_or(1.0));
-    let emissive = m.emissive_factor().map(|e| f64::from(e) * strength);
+    let strength = to_f64(m.emissive_strength().unwrap_or(1.0));
+    let emissive = m.emissive_factor().map(|e| to_f64(e) * strength);
     check(&label, "emission", &emissive)?;
     let emissive_mean = match m.emissive_texture() {
         Some(info) => images

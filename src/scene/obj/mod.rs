@@ -32,7 +32,7 @@ pub(super) mod texture;
 
 use super::{Material, Polygon, Scene};
 use glam::Vec3;
-pub(super) use mtl::{clamp_and_glazing, default_grey};
+pub(super) use mtl::{clamp_and_glazing, default_grey, to_f64};
 use mtl::{convert_material, load_library, textures_and_clamp, MtlLog, MtlSource};
 use std::cell::RefCell;
 use std::collections::HashSet;

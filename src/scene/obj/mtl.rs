@@ -480,7 +480,7 @@ pub(super) fn parse_colour(text: &str) -> Option<[f64; 3]> {
 
 /// tobj's float (f32, or f64 with its `use_f64` feature) as f64, keeping its decimal value:
 /// `Kd 0.725` gives ρ = 0.725, not 0.7250000238418579.
-pub(super) fn to_f64<F: Into<f64> + Copy + std::fmt::Display>(x: F) -> f64 {
+pub(in crate::scene) fn to_f64<F: Into<f64> + Copy + std::fmt::Display>(x: F) -> f64 {
     let exact: f64 = x.into();
     if exact.is_finite() {
         x.to_string().parse().unwrap_or(exact)
