@@ -22,6 +22,7 @@ mod materials;
 #[cfg(test)]
 mod tests;
 
+use super::obj::to_f64;
 use super::{Polygon, Scene, SceneError};
 use crate::scene::LoadOptions;
 use data::{describe, read_accessor, Buffers};
@@ -234,8 +235,7 @@ impl Walk<'_> {
                     "the node hierarchy unfolds into more than {MAX_NODE_VISITS} nodes (nodes shared between parents)"
                 ));
             }
-            let local =
-                DMat4::from_cols_array_2d(&node.transform().matrix().map(|c| c.map(f64::from)));
+            let local = local_transform(&node);
             let world = parent * local;
             if !world.is_finite() {
                 return Err(format!(
@@ -358,6 +358,31 @@ impl Walk<'_> {
             }
         }
         Ok(skipped)
+    }
+}
+
+/// A node's own transform in double precision, its numbers read at their decimal value (a
+/// translation of 1.8 is 1.8, not 1.7999999523): the matrix, or translation × rotation ×
+/// scale with the rotation's quaternion normalised.
+fn local_transform(node: &gltf::Node) -> DMat4 {
+    let v3 = |v: [f32; 3]| DVec3::from(v.map(to_f64));
+    match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => {
+            DMat4::from_cols_array_2d(&matrix.map(|c| c.map(to_f64)))
+        }
+        gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            let q = glam::DQuat::from_array(rotation.map(to_f64));
+            let q = if q.length_squared() > 0.0 {
+                q.normalize()
+            } else {
+                glam::DQuat::IDENTITY
+            };
+            DMat4::from_scale_rotation_translation(v3(scale), q, v3(translation))
+        }
     }
 }
 
