@@ -52,8 +52,10 @@ impl SceneSource {
         }
         if let Some(path) = &opts.luminaires {
             let zenith = Vec3::from(opts.zenith.unwrap_or(crate::sky::DEFAULT_ZENITH.to_array()));
-            scene.luminaires = crate::luminaire::read_schedule(path, zenith.as_dvec3())
+            let placed = crate::luminaire::read_schedule(path, zenith.as_dvec3())
                 .map_err(|e| SceneError::from_line(&path.display().to_string(), &e.to_string()))?;
+            // After the model's own lights (a glTF's), which keep their places in the list.
+            scene.luminaires.extend(placed);
         }
         Ok(scene)
     }

@@ -235,6 +235,7 @@ fn write_obj(dir: &Path) {
 fn solve(dir: &Path, out: &str, args: &[&str]) -> (String, String) {
     let o = dir.join(out);
     let o = o.to_str().unwrap();
+    let saved = format!("{o}.rad");
     let mut all = vec![
         "solve",
         "-q",
@@ -246,6 +247,8 @@ fn solve(dir: &Path, out: &str, args: &[&str]) -> (String, String) {
         "off",
         "--seed",
         "5",
+        "--save",
+        &saved,
     ];
     all.extend(args);
     let (code, _, err) = run(&all);
@@ -329,4 +332,21 @@ fn a_gltf_room_solves_as_the_same_room_in_obj_with_a_schedule() {
             &a[..3]
         );
     }
+    // A saved solution of the glTF model finds its lights again (in the model) for a picture.
+    let mean = |name: &str| {
+        let (sol, png) = (d.join(format!("{name}.rad")), d.join(format!("{name}.hdr")));
+        let (sol, png) = (sol.to_str().unwrap(), png.to_str().unwrap());
+        let args = [
+            "render", sol, "--out", png, "--width", "48", "--height", "36",
+        ];
+        let (code, _, err) = run(&args);
+        assert_eq!(code, 0, "{err}");
+        let img = image::open(png).unwrap().into_rgb32f();
+        img.pixels().map(|px| f64::from(px[1])).sum::<f64>() / img.pixels().len() as f64
+    };
+    let (a, b) = (mean("g"), mean("o"));
+    assert!(
+        b > 0.0 && (a / b - 1.0).abs() < 1e-3,
+        "pictures: {a} against {b}"
+    );
 }

@@ -185,7 +185,7 @@ pub enum SolutionError {
         scene: String,
         scene_hash: u64,
     },
-    #[error("{}: its luminaires: {message} (the solution names their schedule, read again on load)", path.display())]
+    #[error("{}: its luminaires: {message} (read again on load from the schedule or glTF model the solution names)", path.display())]
     Luminaires { path: PathBuf, message: String },
 }
 
@@ -328,6 +328,21 @@ impl SavedSolution {
     /// when the solve had none.
     fn luminaires(&self, path: &Path) -> Result<Vec<crate::luminaire::Luminaire>, SolutionError> {
         let load = self.meta.settings.get("load");
+        // A glTF model's own lights come with the model: it is read again, as it was read
+        // for the solve (its schedule too).
+        let model = Path::new(&self.meta.scene);
+        if crate::scene::is_gltf(model) {
+            let opts: crate::scene::LoadOptions = load
+                .and_then(|l| serde_json::from_value(l.clone()).ok())
+                .unwrap_or_default();
+            let source = crate::scene::SceneSource::File(model.to_path_buf());
+            return source.load(&opts).map(|s| s.luminaires).map_err(|e| {
+                SolutionError::Luminaires {
+                    path: path.to_path_buf(),
+                    message: e.to_string(),
+                }
+            });
+        }
         let Some(schedule) = load
             .and_then(|l| l.get("luminaires"))
             .and_then(|v| v.as_str())
