@@ -1,7 +1,8 @@
 //! The scene as loaded: polygons, materials (reflectance ρ, emission), and the lights.
 //!
-//! This module owns everything that knows about OBJ/MTL (`obj.rs`, the only code that touches
-//! `tobj`) and the built-in default scene (`default.rs`). Downstream code sees only [`Scene`].
+//! This module owns everything that knows about model files: OBJ/MTL (`obj/`, the only code
+//! that touches `tobj`), glTF 2.0 ([`gltf`], the only code that reads glTF; docs/design.md §13)
+//! and the built-in default scene (`default.rs`). Downstream code sees only [`Scene`].
 //!
 //! Units (docs/design.md §1): metres; MTL `Ke` is emitted *radiance* (W/sr/m²) as path tracers and
 //! Radiance read it, so a Lambertian emitter's radiosity is E = π·Ke (W/m²).

@@ -43,9 +43,9 @@ pub struct SkyArgs {
     /// Reflectance of the ground outside the model, which glows below the horizon.
     #[arg(long, default_value_t = DEFAULT_GROUND_REFLECTANCE, value_name = "RHO", allow_negative_numbers = true)]
     pub ground_reflectance: f64,
-    /// The model's up direction X,Y,Z (--up is the same flag). glTF models are Y-up, the
-    /// default; many OBJ exports from CAD are Z-up: 0,0,1.
-    #[arg(long, visible_alias = "up", value_parser = Xyz::parse, allow_hyphen_values = true, default_value_t = Xyz(DEFAULT_ZENITH))]
+    /// The model's up direction X,Y,Z. glTF models are Y-up, the default; many OBJ exports
+    /// from CAD are Z-up: 0,0,1. (--up is the camera's up, not the model's.)
+    #[arg(long, value_parser = Xyz::parse, allow_hyphen_values = true, default_value_t = Xyz(DEFAULT_ZENITH))]
     pub zenith: Xyz,
     /// The model's north X,Y,Z (its horizontal part counts) [default: 0,0,-1 with the default
     /// zenith, 0,1,0 with --zenith 0,0,1 (Radiance's convention); in general −Z turned by the

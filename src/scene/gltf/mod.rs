@@ -6,14 +6,14 @@
 //! from its roots, each node's transform (matrix, or translation × rotation × scale) composed
 //! with its parents'; every triangle of every mesh primitive (indexed or not; strips and fans
 //! unrolled; points and lines are not surfaces) becomes a polygon of the [`Scene`], turned
-//! round where its node's transform mirrors. Materials follow [`materials`], lights
+//! round where its node's transform mirrors. Materials follow `materials.rs`, lights
 //! [`lights`]. glTF is Y-up and in metres, which are the tool's defaults; `--scale` serves
 //! the models that are not. Faces of zero area are dropped with one warning; `--emit`,
 //! `--flip` and the merge of doubled faces apply as for OBJ.
 //!
 //! Anything wrong with the file is one line naming it and the part (buffer, accessor, node,
 //! material) — never a panic: the buffers and accessors are read here with checked arithmetic
-//! ([`data`]), the node graph is walked with its cycles found, and the document is validated
+//! (`data.rs`), the node graph is walked with its cycles found, and the document is validated
 //! by the crate first.
 
 mod data;
