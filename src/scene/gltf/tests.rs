@@ -287,3 +287,35 @@ fn every_fault_is_one_line_naming_its_part() {
         }
     }
 }
+
+#[test]
+fn scale_multiplies_the_model_and_its_lights_and_a_huge_model_is_warned_of() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mm.gltf");
+    let big = TRI.map(|p| p.map(|c| c * 6000.0));
+    let extra = json!({
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 10.0}]}},
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}, {"translation": [3000.0, 2000.0, 0.0],
+            "extensions": {"KHR_lights_punctual": {"light": 0}}}],
+        "scenes": [{"nodes": [0, 1]}],
+    });
+    std::fs::write(&path, document(&big, None, extra)).unwrap();
+    let source = crate::scene::SceneSource::File(path);
+    let raw = source.load(&LoadOptions::default()).unwrap();
+    assert!(
+        raw.warnings
+            .iter()
+            .any(|w| w.contains("6000 m across") && w.contains("--scale")),
+        "{:?}",
+        raw.warnings
+    );
+    let opts = LoadOptions {
+        scale: Some(0.001),
+        ..LoadOptions::default()
+    };
+    let s = source.load(&opts).unwrap();
+    assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert_eq!(s.bounds().1, Vec3::new(6.0, 0.0, 6.0));
+    assert!((s.luminaires[0].position - DVec3::new(3.0, 2.0, 0.0)).length() < 1e-12);
+}
