@@ -16,6 +16,7 @@ mod elements;
 mod error_target;
 mod final_gather;
 mod gather_render;
+mod gltf_mutations;
 mod grid_rooms;
 mod grid_work_plane;
 mod house_rules;
