@@ -71,8 +71,11 @@ impl Rng {
     }
 }
 
+/// Byte ranges (start, end) in a text.
+type Spans = Vec<(usize, usize)>;
+
 /// The byte ranges of the numbers and of the strings (quotes included) of a JSON text.
-fn tokens(json: &[u8]) -> (Vec<(usize, usize)>, Vec<(usize, usize)>) {
+fn tokens(json: &[u8]) -> (Spans, Spans) {
     let (mut numbers, mut strings) = (Vec::new(), Vec::new());
     let mut i = 0;
     while i < json.len() {
