@@ -1,8 +1,9 @@
 //! Bad input: every malformed file in `tests/corpus/` and every bad flag value or
 //! combination gives exactly one error line naming the problem, exit code 2, no panic, and
 //! leaves no output behind (no file, no temporary file, no new folder); the odd but valid
-//! files (`odd-*`: comments after the data, continued lines, Kd of 1 or more, textures) load
-//! and solve with exactly the warnings they deserve.
+//! files (`odd-*`: comments after the data, continued lines, Kd of 1 or more, textures, glTF
+//! rooms) load and solve with exactly the warnings they deserve. The glTF files are written by
+//! `tests/corpus/make_gltf.py`.
 //!
 //! The table below is the corpus index: one row per case, `{c}` standing for `tests/corpus`,
 //! `{s}` for a shared folder holding a solved solution (`{s}/sol.rad`, `{s}/o/patches.csv`),
@@ -16,7 +17,8 @@ use std::path::Path;
 /// (what is wrong, the command line, words the error line must hold).
 type Case = (&'static str, &'static str, &'static [&'static str]);
 
-/// Malformed OBJ/MTL files, one per corpus file (the OBJ of an OBJ+MTL pair stands for both).
+/// Malformed files, one per corpus file (the OBJ of an OBJ+MTL pair stands for both, the
+/// `.gltf` of a `.gltf`+`.bin` pair too).
 #[rustfmt::skip]
 const FILES: &[Case] = &[
     ("missing file", "solve -q {c}/no-such-file.obj --out {t}/o", &["no-such-file.obj", "cannot read", "no such file"]),
@@ -76,6 +78,27 @@ const FILES: &[Case] = &[
     ("schedule with no luminaire", "solve -q {c}/lit.obj --luminaires {c}/schedule-empty.csv --out {t}/o", &["schedule-empty.csv: no luminaires listed"]),
     ("JSON schedule with an unknown key", "solve -q {c}/lit.obj --luminaires {c}/schedule-unknown-key.json --out {t}/o", &["schedule-unknown-key.json:1", "unknown field `brightness`"]),
     ("info of a garbled IES file", "info {c}/garbage-web.ies", &["garbage-web.ies:4", "vertical angles"]),
+    // glTF models, made by tests/corpus/make_gltf.py: the container, then the data, then the
+    // document's structure.
+    ("glTF: a .glb cut in its binary chunk", "solve -q {c}/gltf-truncated.glb --out {t}/o", &["gltf-truncated.glb", "not a readable .glb file"]),
+    ("glTF: a .glb whose magic is not glTF", "solve -q {c}/gltf-bad-magic.glb --out {t}/o", &["gltf-bad-magic.glb", "not a readable glTF document"]),
+    ("glTF: a .glb of version 1", "solve -q {c}/gltf-bad-version.glb --out {t}/o", &["gltf-bad-version.glb", "not a readable .glb file", "unsupported version"]),
+    ("glTF: not JSON", "solve -q {c}/gltf-not-json.gltf --out {t}/o", &["gltf-not-json.gltf", "not a readable glTF document", "line 1 column 1"]),
+    ("glTF: JSON without an asset", "solve -q {c}/gltf-empty-object.gltf --out {t}/o", &["gltf-empty-object.gltf", "missing field `asset`"]),
+    ("glTF: a buffer naming a missing file", "solve -q {c}/gltf-missing-bin.gltf --out {t}/o", &["gltf-missing-bin.gltf", "buffer 0", "no-such-buffer.bin", "no such file"]),
+    ("glTF: a buffer shorter than its byteLength", "solve -q {c}/gltf-buffer-short.gltf --out {t}/o", &["gltf-buffer-short.gltf", "buffer 0 holds 180 bytes", "byteLength says 360"]),
+    ("glTF: a buffer view past its buffer", "solve -q {c}/gltf-view-past-buffer.gltf --out {t}/o", &["gltf-view-past-buffer.gltf", "buffer view 0", "past the end of buffer 0"]),
+    ("glTF: a byteStride shorter than an element", "solve -q {c}/gltf-stride-shorter-than-element.gltf --out {t}/o", &["gltf-stride-shorter-than-element.gltf", "accessor 0", "positions of mesh 0 'tri'"]),
+    ("glTF: an accessor of count 0", "solve -q {c}/gltf-accessor-count-zero.gltf --out {t}/o", &["gltf-accessor-count-zero.gltf", "accessor 0", "has no elements"]),
+    ("glTF: NaN in the positions", "solve -q {c}/gltf-position-nan.glb --out {t}/o", &["gltf-position-nan.glb", "accessor 0", "element 2 holds NaN"]),
+    ("glTF: an index past the vertex count", "solve -q {c}/gltf-index-out-of-range.glb --out {t}/o", &["gltf-index-out-of-range.glb", "mesh 0 'tri', primitive 0", "index 7", "its 4 vertices"]),
+    ("glTF: lines only", "solve -q {c}/gltf-lines-only.gltf --out {t}/o", &["gltf-lines-only.gltf", "no polygons"]),
+    ("glTF: a node cycle", "solve -q {c}/gltf-node-cycle.gltf --out {t}/o", &["gltf-node-cycle.gltf", "node 0 'tri'", "its own ancestor", "cycle"]),
+    ("glTF: Draco compression required", "solve -q {c}/gltf-requires-draco.gltf --out {t}/o", &["gltf-requires-draco.gltf", "KHR_draco_mesh_compression"]),
+    ("glTF: a spot light of negative intensity", "solve -q {c}/gltf-spot-negative-intensity.gltf --out {t}/o", &["gltf-spot-negative-intensity.gltf", "downlight", "intensity -5"]),
+    ("glTF: a negative base colour", "solve -q {c}/gltf-base-colour-negative.gltf --out {t}/o", &["gltf-base-colour-negative.gltf", "material 0 'floor'", "base colour -0.5"]),
+    ("glTF: no light", "solve -q {c}/gltf-no-light.gltf --out {t}/o", &["gltf-no-light.gltf", "no light", "--emit"]),
+    ("info reads glTF the same way", "info {c}/gltf-position-nan.glb", &["gltf-position-nan.glb", "element 2 holds NaN"]),
     // Generated here rather than committed (the repository stays small).
     ("an extremely long line", "solve -q {s}/long-line.obj --out {t}/o", &["long-line.obj", "vertex 3 (line 3)", "not finite"]),
     ("10^6 zero-area faces", "solve -q {s}/million-faces.obj --out {t}/o", &["million-faces.obj", "all 1000000 faces have zero area"]),
@@ -153,6 +176,9 @@ const ODD: &[OddCase] = &[
     ("Kd above 1 is clamped", "solve -q {c}/odd-kd-above-one.obj --out {t}/o", &["clamped to 0.98", "'white'"]),
     ("Kd 1 1 1 with a texture, and with a missing one", "solve -q {c}/odd-kd-one-with-texture.obj --out {t}/o",
         &["1 texture(s) not loaded", "'lamp'", "lamp-texture-that-is-not-there.png: no such file", "clamped to 0.98 (a closed room"]),
+    // Made by tests/corpus/make_gltf.py: a closed room, its walls a colour times a PNG texture.
+    ("glTF room: a point light, the texture in the .glb's binary chunk", "solve -q {c}/odd-gltf-room.glb --out {t}/o", &[]),
+    ("glTF room: a point and a spot light, buffer and texture in data URIs", "solve -q {c}/odd-gltf-room-data-uri.gltf --out {t}/o", &[]),
 ];
 
 fn corpus() -> &'static Path {
@@ -321,7 +347,12 @@ fn odd_but_valid_input_loads_and_solves() {
 fn every_corpus_file_is_used() {
     let used: String = FILES.iter().chain(FLAGS).chain(ODD).map(|c| c.1).collect();
     for name in listing(corpus()) {
+        if name == "make_gltf.py" {
+            // What writes the glTF files, not a case.
+            continue;
+        }
         let stem = name
+            .trim_end_matches(".bin")
             .trim_end_matches(".png")
             .trim_end_matches(".mtl")
             .trim_end_matches(".obj")

@@ -17,6 +17,7 @@ mod error_target;
 mod final_gather;
 mod gather_render;
 mod gltf;
+mod gltf_mutations;
 mod grid_rooms;
 mod grid_work_plane;
 mod house_rules;
