@@ -227,7 +227,7 @@ fn solve_into(
 ) -> Result<Summary, Error> {
     let mut timings = Timings::default();
     let scene = stages::load(job, progress, log)?;
-    let sunlit = stages::model_sun(job, &scene, log)?;
+    let sunlit = daylight::model_sun(job, &scene, log)?;
     let job = sunlit.as_ref().unwrap_or(job);
     timings.load = t0.elapsed().as_secs_f64();
     timings.peak.load = report::peak_mib();

@@ -74,61 +74,6 @@ pub fn load(
     Ok(scene)
 }
 
-/// The model's sun: a model that brings its own (a glTF directional light, [`crate::scene::ModelSun`]) is lit
-/// by it unless `--sun` places one: under the `--sky` asked for, or under a black sky (uniform,
-/// 0 lux: the sun alone, and the ground it lights, as `gensky -s` with `-b 0` would give).
-/// Returns the job so changed (the settings recorded and saved are then the ones solved), or
-/// `None` when nothing changes.
-pub fn model_sun(
-    job: &SolveJob,
-    scene: &Scene,
-    log: &mut impl FnMut(&str),
-) -> Result<Option<SolveJob>, Error> {
-    use crate::sky::{SkyKind, SkyLevel, SkySpec, SolarAngles, SunLevel};
-    let Some(sun) = &scene.sun else {
-        return Ok(None);
-    };
-    let sky = job.settings.solve.sky;
-    if sky.is_some_and(|s| s.sun_position.is_some()) {
-        log(&format!(
-            "the model's directional light '{}' is left out: --sun places the sun",
-            sun.name
-        ));
-        return Ok(None);
-    }
-    let compass = super::daylight::frame_of(job);
-    let local = compass.to_local(sun.towards);
-    let altitude = local.z.clamp(-1.0, 1.0).asin().to_degrees();
-    let azimuth = (-local.x).atan2(-local.y).to_degrees();
-    let angles = SolarAngles::new(altitude, azimuth)?;
-    let spec = SkySpec {
-        sun_position: Some(angles),
-        sun: Some(SunLevel::NormalIlluminance(sun.illuminance)),
-        ..sky.unwrap_or(SkySpec {
-            kind: SkyKind::Uniform,
-            level: SkyLevel::HorizontalIlluminance(0.0),
-            zenith: compass.up().as_vec3(),
-            north: compass.north().as_vec3(),
-            ..SkySpec::default()
-        })
-    };
-    spec.check()?;
-    let under = if sky.is_some() {
-        "under the sky asked for"
-    } else {
-        "under a black sky (--sky for daylight too)"
-    };
-    log(&format!(
-        "sun: the model's directional light '{}', {:.0} lux at altitude {altitude:.1}°, azimuth {azimuth:.1}° west of south, {under}{}",
-        sun.name,
-        sun.illuminance,
-        if sun.white { "" } else { "; its colour is left out (the sun is white)" }
-    ));
-    let mut out = job.clone();
-    out.settings.solve.sky = Some(spec);
-    Ok(Some(out))
-}
-
 /// Mesh: cuts the scene into patches, logging the patch size chosen and the counts.
 pub fn mesh(
     job: &SolveJob,

@@ -337,6 +337,7 @@ const SHAPING: &[Shaping] = &[
     shaping("uniform-patches", &["--uniform-patches"], &[]),
     shaping("flip", &["--flip"], &[]),
     shaping("luminaires", &["--luminaires", "lamps.csv"], &[]),
+    shaping("scale", &["--scale", "0.5"], &[]),
     shaping("seed", &["--seed", "7"], &[]),
     shaping("tolerance", &["--tolerance", "0.1"], &[]),
     shaping("energy-per-ray", &["--energy-per-ray", "0.5"], &[]),

@@ -124,6 +124,19 @@ fn parse(bytes: &[u8]) -> Result<gltf::Gltf, String> {
 /// which exporters leave out and the loader does not read.
 fn validate(root: &gltf::json::Root) -> Result<(), String> {
     use gltf::json::validation::{Error, Validate};
+    // The crate's check of a primitive's POSITION reads its accessor before any check that
+    // it exists (gltf-json 1.4 indexes the accessors unchecked there).
+    let accessors = root.accessors.len();
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            if let Some(a) = prim.attributes.values().find(|a| a.value() >= accessors) {
+                return Err(format!(
+                    "an invalid glTF document (meshes[{m}].primitives[{p}] names accessor {}, of {accessors})",
+                    a.value()
+                ));
+            }
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path().to_string();
