@@ -8,6 +8,10 @@ use base64::Engine;
 use gltf::accessor::{DataType, Dimensions};
 use std::path::Path;
 
+/// The most values a sparse accessor without a buffer view (all zeros but its substitutions)
+/// may declare: 60 M (20 M points of three), the tool's patch limit in vertices.
+const MAX_SPARSE_VALUES: usize = 60_000_000;
+
 /// The bytes of every buffer, in the document's order.
 pub struct Buffers(Vec<Vec<u8>>);
 
@@ -214,7 +218,15 @@ pub fn read_accessor(
             .ok_or_else(outside)?;
         }
         // No view: zeros, for the sparse values to fill.
-        None => values.resize(count * n, 0.0),
+        None => {
+            let total = count
+                .checked_mul(n)
+                .filter(|t| *t <= MAX_SPARSE_VALUES)
+                .ok_or_else(|| {
+                    format!("{name} declares {count} elements, more than it can hold")
+                })?;
+            values.resize(total, 0.0)
+        }
     }
     if let Some(sparse) = acc.sparse() {
         let k = sparse.count();

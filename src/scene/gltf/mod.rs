@@ -48,6 +48,10 @@ const UNDERSTOOD: &[&str] = &[
 /// forbids) can otherwise multiply them without end.
 const MAX_NODE_VISITS: usize = 10_000_000;
 
+/// The most triangles a model may unfold into (a mesh counted once per node that places
+/// it): about the tool's patch limit, far above a building's.
+const MAX_TRIANGLES: usize = 20_000_000;
+
 /// Whether `path` names a glTF model (`.gltf` or `.glb`, any case).
 pub fn is_gltf(path: &Path) -> bool {
     path.extension()
@@ -100,6 +104,15 @@ pub fn load_gltf_from_slice(
 /// The document, validated; a file that is not glTF, a `.glb` cut short, a document the
 /// crate finds invalid or one that requires an extension not read here is an error.
 fn parse(bytes: &[u8]) -> Result<gltf::Gltf, String> {
+    // The crate subtracts the header's 12 bytes from the length it declares unchecked.
+    if bytes.starts_with(b"glTF") {
+        let declared = bytes
+            .get(8..12)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if declared.is_none_or(|n| n < 12) {
+            return Err("not a readable .glb file (its header is cut short)".into());
+        }
+    }
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| match e {
         gltf::Error::Binary(b) => format!("not a readable .glb file ({b})"),
         gltf::Error::Deserialize(d) => format!("not a readable glTF document ({d})"),
@@ -232,11 +245,14 @@ impl Walk<'_> {
             .collect();
         // The nodes on the path from the root to the one visited: a child among them is a cycle.
         let mut path: Vec<usize> = Vec::new();
+        let mut on_path = vec![false; doc.nodes().len()];
         let (mut visits, mut skipped, mut dark) = (0usize, 0usize, Vec::new());
         let mut suns = Vec::new();
         while let Some((node, parent, depth)) = stack.pop() {
-            path.truncate(depth);
-            if path.contains(&node.index()) {
+            for left in path.drain(depth.min(path.len())..) {
+                on_path[left] = false;
+            }
+            if on_path[node.index()] {
                 return Err(format!(
                     "{} is its own ancestor: the node hierarchy has a cycle",
                     describe("node", node.index(), node.name())
@@ -271,6 +287,7 @@ impl Walk<'_> {
                 }
             }
             path.push(node.index());
+            on_path[node.index()] = true;
             for child in node.children().collect::<Vec<_>>().into_iter().rev() {
                 stack.push((child, world, depth + 1));
             }
@@ -343,6 +360,11 @@ impl Walk<'_> {
                     continue;
                 }
             };
+            if scene.polygons.len() + triangles.len() > MAX_TRIANGLES {
+                return Err(format!(
+                    "the model unfolds into more than {MAX_TRIANGLES} triangles (its meshes placed by all their nodes)"
+                ));
+            }
             let base = scene.positions.len() as u32;
             for k in 0..count {
                 let v = world.transform_point3(DVec3::new(p[3 * k], p[3 * k + 1], p[3 * k + 2]));
