@@ -270,7 +270,7 @@ pub fn scalar(v: &[f64; 3]) -> f64 {
 /// Errors a user can cause.
 #[derive(Debug, thiserror::Error)]
 pub enum SolveError {
-    #[error("the scene has no light: no material emits (give one a Ke in the MTL file, or use --emit MATERIAL=R,G,B)")]
+    #[error("the scene has no light: no material emits (give one a Ke in the MTL file or an emissive factor in the glTF, or use --emit MATERIAL=R,G,B, --luminaires, --sky)")]
     NoEmitter,
     #[error("the scene has {0} patches; at most {max} are supported", max = ray_shots::BACK - 1)]
     TooManyPatches(usize),

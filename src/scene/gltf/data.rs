@@ -207,6 +207,13 @@ pub fn read_accessor(
         Some(view) => {
             let bytes = buffers.view(&view)?;
             let stride = view.stride().unwrap_or(0);
+            let element = ty.size() * n;
+            if stride != 0 && stride < element {
+                return Err(format!(
+                    "{name}: its buffer view's byteStride {stride} is shorter than an element \
+                     ({element} bytes)"
+                ));
+            }
             read_elements(
                 bytes,
                 acc.offset(),

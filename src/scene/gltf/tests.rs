@@ -319,3 +319,16 @@ fn scale_multiplies_the_model_and_its_lights_and_a_huge_model_is_warned_of() {
     assert_eq!(s.bounds().1, Vec3::new(6.0, 0.0, 6.0));
     assert!((s.luminaires[0].position - DVec3::new(3.0, 2.0, 0.0)).length() < 1e-12);
 }
+
+#[test]
+fn a_required_extension_that_changes_nothing_here_is_read_past() {
+    let extra = json!({
+        "extensionsRequired": ["KHR_texture_transform", "KHR_materials_specular"],
+        "extensionsUsed": ["KHR_texture_transform", "KHR_materials_specular"],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+    });
+    let s = load(&document(&TRI, None, extra)).unwrap();
+    assert_eq!(s.polygons.len(), 1);
+}
