@@ -290,7 +290,7 @@ impl<I: Intersector> Kernel<'_, I> {
         }
         if !self.mesh.luminaires.is_empty() {
             // One luminaire, drawn by its flux: its exact light at y by a shadow ray.
-            let (l, k, cast) = self.luminaire_by_flux(&from, rng.gen());
+            let (l, k, cast) = self.luminaire_by_flux(&from, rng);
             acc.rays += u64::from(cast);
             acc.v += l;
             if let Some(c) =

@@ -1,8 +1,10 @@
 //! Direct light from the luminaires (docs/design.md §12): a placed luminaire is a point with a
-//! photometric web ([`crate::luminaire`]), so its irradiance at a point x facing n is exact,
-//! not sampled over an area: E = I(ω)·cos θ / r², I its intensity toward x (W/sr), θ the
-//! angle at x, r the distance — when a shadow ray from x reaches the luminaire (through
-//! glazing, tinted by it). A hemisphere ray never meets a point, so no MIS weight is needed:
+//! photometric web ([`crate::luminaire`]), so its irradiance at a point x facing n is exact:
+//! E = I(ω)·cos θ / r², I its intensity toward x (W/sr), θ the angle at x, r the distance —
+//! when a shadow ray from x reaches the luminaire (through glazing, tinted by it). Where the
+//! file gives a luminous opening with an area, the web is spread evenly over it (as
+//! Radiance's `ies2rad` sources are) and E is its mean over stratified points of the opening,
+//! each with its own shadow ray: right near the luminaire, the point's value far from it. A hemisphere ray never meets a point, so no MIS weight is needed:
 //! the shadow rays carry all of a luminaire's direct light and the hemisphere rays what its
 //! light does after its first bounce.
 //!
@@ -16,7 +18,7 @@ use super::gather::{latin, stratified_var, Gathered, Spot};
 use super::{scalar, Kernel, Origin, Rgb};
 use crate::intersect::{Intersector, Ray};
 use crate::luminaire::Luminaire;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use rand::Rng;
 
 /// Up to this many luminaires, each point of a gather takes the light of every one.
@@ -29,7 +31,12 @@ const UNIFORM_SHARE: f64 = 0.1;
 /// The unoccluded irradiance (RGB, W/m²) luminaire `l` gives a point `x` facing `n`, with the
 /// direction and distance to it; `None` when it is behind the point or gives nothing.
 pub fn unoccluded(l: &Luminaire, x: Vec3, n: Vec3) -> Option<(Rgb, Vec3, f32)> {
-    let d = l.position - x.as_dvec3();
+    unoccluded_from(l, l.position, x, n)
+}
+
+/// [`unoccluded`] from point `at` of the luminaire's opening.
+fn unoccluded_from(l: &Luminaire, at: DVec3, x: Vec3, n: Vec3) -> Option<(Rgb, Vec3, f32)> {
+    let d = at - x.as_dvec3();
     let r2 = d.length_squared();
     if !(r2 > 0.0 && r2.is_finite()) {
         return None;
@@ -47,9 +54,17 @@ pub fn unoccluded(l: &Luminaire, x: Vec3, n: Vec3) -> Option<(Rgb, Vec3, f32)> {
 impl<I: Intersector> Kernel<'_, I> {
     /// Luminaire `k`'s irradiance at `from` (RGB): its unoccluded light where a shadow ray
     /// reaches it (tinted by the glazing it passes), else 0; and whether a ray was cast.
-    pub(super) fn luminaire_sample(&self, from: &Origin, k: usize) -> (Rgb, bool) {
+    /// `opening`: where on a luminaire's luminous opening the light is taken from
+    /// ([`Luminaire::opening_point`]; ignored without an opening).
+    pub(super) fn luminaire_sample(
+        &self,
+        from: &Origin,
+        k: usize,
+        opening: (f64, f64),
+    ) -> (Rgb, bool) {
         let l = &self.mesh.luminaires[k];
-        let Some((e, dir, r)) = unoccluded(l, from.x, from.n) else {
+        let at = l.opening_point(opening.0, opening.1);
+        let Some((e, dir, r)) = unoccluded_from(l, at, from.x, from.n) else {
             return (Rgb::ZERO, false);
         };
         let ray = Ray {
@@ -67,9 +82,14 @@ impl<I: Intersector> Kernel<'_, I> {
 
     /// One luminaire drawn by its flux (`s` uniform in [0, 1)) and its light at `from` divided
     /// by the chance of the draw (RGB), the luminaire, and whether a ray was cast.
-    pub(super) fn luminaire_by_flux(&self, from: &Origin, s: f64) -> (Rgb, usize, bool) {
-        let (k, p) = pick(&self.luminaire_flux_cdf, s);
-        let (e, cast) = self.luminaire_sample(from, k);
+    pub(super) fn luminaire_by_flux<R: Rng>(
+        &self,
+        from: &Origin,
+        rng: &mut R,
+    ) -> (Rgb, usize, bool) {
+        let (k, p) = pick(&self.luminaire_flux_cdf, rng.gen());
+        let (e, cast) =
+            self.luminaire_sample(from, k, opening_sample(&self.mesh.luminaires[k], rng));
         (e / p, k, cast)
     }
 
@@ -85,17 +105,27 @@ impl<I: Intersector> Kernel<'_, I> {
         rng: &mut R,
     ) {
         let lums = &self.mesh.luminaires;
-        let n = luminaire_points(spot, rays, lums.len());
+        let n = luminaire_points(spot, rays, lums);
         let points = latin(n, true, rng);
+        // Points of the luminous openings, stratified apart from the receiver's (drawn only
+        // where a luminaire has an opening, so point sources keep their random numbers).
+        let openings = if lums.iter().any(Luminaire::has_opening) {
+            latin(n, true, rng)
+        } else {
+            Vec::new()
+        };
         let draw = (lums.len() > ALL_BELOW).then(|| self.luminaire_draw(spot));
         let (mut m, mut sum) = (Vec::with_capacity(n), Rgb::ZERO);
-        for &(u, v) in &points {
+        for (j, &(u, v)) in points.iter().enumerate() {
             let from = spot.origin(u, v);
+            let at = openings
+                .get(j)
+                .map_or((0.5, 0.5), |&(a, b)| (f64::from(a), f64::from(b)));
             let mut val = Rgb::ZERO;
             match &draw {
                 None => {
                     for k in 0..lums.len() {
-                        let (e, cast) = self.luminaire_sample(&from, k);
+                        let (e, cast) = self.luminaire_sample(&from, k, at);
                         g.rays += u64::from(cast);
                         self.add_luminaire_channel(g, k, e, n as f64);
                         val += e;
@@ -103,7 +133,7 @@ impl<I: Intersector> Kernel<'_, I> {
                 }
                 Some(cdf) => {
                     let (k, p) = pick(cdf, rng.gen());
-                    let (e, cast) = self.luminaire_sample(&from, k);
+                    let (e, cast) = self.luminaire_sample(&from, k, at);
                     g.rays += u64::from(cast);
                     let e = e / p;
                     self.add_luminaire_channel(g, k, e, n as f64);
@@ -153,11 +183,23 @@ impl<I: Intersector> Kernel<'_, I> {
 /// How many points of `spot` take the luminaires' light, on top of the gather's `rays`: a
 /// quarter as many, at least 4 — or one, for a single point (a sensor) lit by few enough
 /// luminaires that it takes every one's light exactly.
-fn luminaire_points(spot: &Spot, rays: usize, luminaires: usize) -> usize {
-    if spot.patch == super::NO_PATCH && luminaires <= ALL_BELOW {
+fn luminaire_points(spot: &Spot, rays: usize, lums: &[Luminaire]) -> usize {
+    let exact = lums.len() <= ALL_BELOW && !lums.iter().any(Luminaire::has_opening);
+    if spot.patch == super::NO_PATCH && exact {
         1
     } else {
         (rays / 4).max(4)
+    }
+}
+
+/// Where on `l`'s luminous opening a sample takes its light: two uniform numbers drawn from
+/// `rng` where it has an opening, none (the centre) where it has not, so that point sources
+/// draw exactly what they drew before openings were read.
+fn opening_sample<R: Rng>(l: &Luminaire, rng: &mut R) -> (f64, f64) {
+    if l.has_opening() {
+        (rng.gen(), rng.gen())
+    } else {
+        (0.5, 0.5)
     }
 }
 

@@ -93,6 +93,48 @@ impl Luminaire {
     }
 }
 
+impl Luminaire {
+    /// Whether its file gives a luminous opening with an area (LM-63's width, length or
+    /// height; EULUMDAT's luminous area): its direct light is then taken from points spread
+    /// over the opening ([`Luminaire::opening_point`]) rather than from its centre.
+    pub fn has_opening(&self) -> bool {
+        let o = &self.photometry.luminous_opening;
+        [o.width, o.length, o.height]
+            .iter()
+            .filter(|x| **x > 0.0)
+            .count()
+            >= 2
+    }
+
+    /// A point of the luminous opening for `(a, b)` uniform in [0, 1)² (the photometric
+    /// centre without an opening): a rectangle (LM-63's flat rectangle and box, at the
+    /// centre's height) of its length along C0 and width along C90, or for the round shapes an
+    /// ellipse over the first two of length (C0), width (C90) and height (up) it has. Uniform
+    /// over the area, so that the far-field intensity spread evenly over it gives its light
+    /// near by as Radiance's `ies2rad` sources do: E = mean over the opening of I(ω)·cos θ/r².
+    pub fn opening_point(&self, a: f64, b: f64) -> DVec3 {
+        use crate::photometry::OpeningShape as S;
+        if !self.has_opening() {
+            return self.position;
+        }
+        let o = &self.photometry.luminous_opening;
+        let f = &self.frame;
+        let axes = [(o.length, f.c0), (o.width, f.c90), (o.height, -f.aim)];
+        let mut it = axes.iter().filter(|(x, _)| *x > 0.0);
+        let (Some(&(l1, u1)), Some(&(l2, u2))) = (it.next(), it.next()) else {
+            return self.position;
+        };
+        let (x, y) = match o.shape {
+            S::Rectangle | S::Box => (a - 0.5, b - 0.5),
+            _ => {
+                let (r, phi) = (a.sqrt() / 2.0, std::f64::consts::TAU * b);
+                (r * phi.cos(), r * phi.sin())
+            }
+        };
+        self.position + u1 * (x * l1) + u2 * (y * l2)
+    }
+}
+
 /// The IES tilt factor of `photometry` for a luminaire aimed along `aim` in a model whose up
 /// direction is `zenith`: the tilt table's factor at the angle between the aim and the nadir
 /// (−zenith), degrees (0 aimed straight down, 90 aimed at the horizon), or 1 without a table.

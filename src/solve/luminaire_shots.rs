@@ -7,7 +7,8 @@
 //! distribution ([`FluxCells`]), its direction drawn inside the cell in proportion to the
 //! intensity, so the rays' density is I(ω)/Φ exactly, stratified by the cells. The cells are
 //! turned by a random offset per luminaire, as the hemisphere's polar cells are turned per
-//! shot. The rays leave the luminaire's photometric centre; a ray that meets a front face
+//! shot. The rays leave the luminaire's photometric centre, or a point drawn uniformly over
+//! its luminous opening where the file gives one with an area; a ray that meets a front face
 //! deposits Φ/X there like any shot's, one meeting a back face is lost on it (the books'
 //! `absorbed_back`), one that meets nothing leaves.
 //!
@@ -84,7 +85,7 @@ pub(super) fn shoot<I: Intersector>(
                 .collect()
         });
         st.emit_point(&phi);
-        let org = l.position.as_vec3();
+        let (org, opening) = (l.position.as_vec3(), l.has_opening());
         let mut rng = rng_for(seed, Stream::Luminaires, (k as u64) << 32);
         let turn: f64 = rng.gen();
         let chunks: Vec<usize> = (0..x.div_ceil(CHUNK)).collect();
@@ -102,7 +103,13 @@ pub(super) fn shoot<I: Intersector>(
                 },
                 |r, rng: &mut _| {
                     let local = cells.sample(r / per_cell, rng.gen(), rng.gen(), turn);
-                    (org, l.frame.to_world(local).as_vec3().normalize_or_zero())
+                    let dir = l.frame.to_world(local).as_vec3().normalize_or_zero();
+                    // From a point of the luminous opening, where the file gives one.
+                    let from = match opening {
+                        true => l.opening_point(rng.gen(), rng.gen()).as_vec3(),
+                        false => org,
+                    };
+                    (from, dir)
                 },
             );
             for (code, tint) in hits.iter().flat_map(Hits::iter) {

@@ -271,3 +271,76 @@ fn a_solve_with_luminaires_is_the_same_on_any_thread_count() {
     assert_eq!(one.b, two.b);
     assert!(one.b.iter().any(|b| b[1] > 0.0));
 }
+
+/// A luminaire whose file gives a luminous opening (a 0.6 m square) lights the plane 0.3 m
+/// below it as its web spread evenly over the opening: E = mean over the square of
+/// I·cos θ/r² (here half the point source's value under its centre), within 1 %; 3 m away
+/// it is the point's value.
+#[test]
+fn a_luminous_opening_lights_what_is_near_it_from_its_whole_area() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let square = isotropic(1000.0).replace("1 1 2 0 0 0\n", "1 1 2 0.6 0.6 0\n");
+    assert_ne!(square, isotropic(1000.0));
+    write(d, "square.ies", &square);
+    write(d, "plane.mtl", "newmtl black\nKd 0 0 0\n");
+    write(
+        d,
+        "plane.obj",
+        "mtllib plane.mtl\nv -10 0 -10\nv 10 0 -10\nv 10 0 10\nv -10 0 10\nusemtl black\nf 4 3 2 1\n",
+    );
+    write(d, "lum.csv", "file,x,y,z\nsquare.ies,0,0.3,0\n");
+    let places = [(0.0, 0.0), (0.25, 0.1), (0.6, -0.2), (3.0, 0.0)];
+    let mut pts = String::from("x,y,z,nx,ny,nz\n");
+    for (x, z) in places {
+        pts += &format!("{x},0,{z},0,1,0\n");
+    }
+    write(d, "pts.csv", &pts);
+    let out = d.join("out");
+    let (code, _, err) = run(&[
+        "solve",
+        d.join("plane.obj").to_str().unwrap(),
+        "--luminaires",
+        d.join("lum.csv").to_str().unwrap(),
+        "--grid",
+        d.join("pts.csv").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let grid = std::fs::read_to_string(out.join("grid.csv")).unwrap();
+    let lux: Vec<f64> = grid
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(6).unwrap().parse().unwrap())
+        .collect();
+    // The mean over the square by the midpoint rule, 400 × 400.
+    let spread = |x: f64, z: f64| {
+        let n = 400;
+        let mut sum = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let (px, pz) = (
+                    -0.3 + 0.6 * (i as f64 + 0.5) / n as f64,
+                    -0.3 + 0.6 * (j as f64 + 0.5) / n as f64,
+                );
+                let r2 = (px - x).powi(2) + 0.09 + (pz - z).powi(2);
+                sum += 1000.0 * 0.3 / r2.powf(1.5);
+            }
+        }
+        sum / (n * n) as f64
+    };
+    for ((x, z), got) in places.iter().zip(&lux) {
+        let want = spread(*x, *z);
+        assert!(
+            (got / want - 1.0).abs() < 0.01,
+            "at ({x}, {z}): {got} lux against {want}"
+        );
+    }
+    let point = 1000.0 * 0.3 / (0.09f64).powf(1.5);
+    assert!(
+        lux[0] < 0.6 * point,
+        "under the centre {} against the point's {point}",
+        lux[0]
+    );
+}
