@@ -9,7 +9,8 @@ room lit only by photometric luminaires.
    spot aimed at a wall point and spun, and the pendant over the table.
 2. The tool: ``radiosity solve ROOM --luminaires SCHEDULE --grid 0.8,0.5 --out DIR/solve``.
 3. Radiance at the same sensors: the room written by ``objrad.py`` from the tool's own
-   materials; each luminaire by ``ies2rad -dm -i 0.01`` (an ``illum`` sphere of 1 cm at the
+   materials; each luminaire by ``ies2rad -dm -i 0.01`` (with ``--opening W,L,H``, the webs carry
+   that luminous opening and ``ies2rad`` makes its area source instead) (an ``illum`` sphere of 1 cm at the
    photometric centre, Radiance's ``source.cal`` distribution: 0 deg horizontal along +X, 90 along
    +Y, the nadir -Z, the same local frame as the tool's), multiplied by its scale, tinted, then
    turned and moved by ``xform`` into the frame the tool reports (``radiosity info --json
@@ -44,10 +45,15 @@ EFFICACY = 179.0
 PHOTOPIC = np.array([0.265, 0.670, 0.065])
 
 
+# The luminous opening every web is written with (width, length), metres; (0, 0): points.
+OPENING = (0.0, 0.0, 0.0)
+
+
 def ies(name: str, vertical, horizontal, f) -> str:
     """An LM-63-2002 file of absolute candela f(C, gamma) over the given angles."""
+    w, l, h = OPENING
     lines = ["IESNA:LM-63-2002", f"[TEST] {name}", "[MANUFAC] radiosity test webs", "TILT=NONE",
-             f"1 -1 1 {len(vertical)} {len(horizontal)} 1 2 0 0 0", "1 1 30",
+             f"1 -1 1 {len(vertical)} {len(horizontal)} 1 2 {w:g} {l:g} {h:g}", "1 1 30",
              " ".join(f"{v:g}" for v in vertical), " ".join(f"{h:g}" for h in horizontal)]
     for c in horizontal:
         lines.append(" ".join(f"{f(c, g):.4f}" for g in vertical))
@@ -65,7 +71,9 @@ def write_webs(out: Path):
         lambda c, g: 4000 * max(cos(g), 0) ** 30 + 20 * max(cos(g), 0)))
     (out / "pendant.ies").write_text(ies(
         "pendant", steps(0, 180, 10), [0],
-        lambda c, g: 300 + 200 * cos(g)))
+        # A flat opening (ies2rad's downward rectangle) cannot send light up: with one, the
+        # pendant's upper half is dark in both programs.
+        lambda c, g: 300 + 200 * cos(g) if g <= 90 or not any(OPENING) or OPENING[2] > 0 else 0))
 
 
 def box(verts, faces, lo, hi, mat, inward=False):
@@ -131,13 +139,18 @@ def euler_xyz(r: np.ndarray):
 def luminaire_rad(bin_dir, env, lum: dict, k: int, out: Path) -> str:
     """One luminaire as Radiance text: ies2rad's output, scaled and tinted, turned and moved."""
     stem = out / f"lum{k}"
-    res = subprocess.run([bin_dir / "ies2rad", "-dm", "-i", "0.01", "-m", f"{lum['scale']:.9g}",
+    # Points as 1 cm spheres; webs with an opening as ies2rad makes them (area sources).
+    sphere = [] if any(OPENING) else ["-i", "0.01"]
+    res = subprocess.run([bin_dir / "ies2rad", "-dm", *sphere, "-m", f"{lum['scale']:.9g}",
                           "-o", str(stem), lum["file"]], capture_output=True, text=True, env=env)
     if res.returncode != 0:
         sys.exit(f"ies2rad failed: {res.stderr}")
     text = stem.with_suffix(".rad").read_text()
     rgb = " ".join(f"{c:.9g}" for c in lum["colour"])
     text = text.replace("3 1 1 1", f"3 {rgb}", 1)
+    # An opening as an `illum`, seen by direct light only: the tool's luminaires have no
+    # surface, so the reference's must not shade the ceiling or soak up light that meets it.
+    text = text.replace(f"lum{k}_dist' light ", f"lum{k}_dist' illum ")
     stem.with_suffix(".rad").write_text(text)
     aim, c0 = np.array(lum["aim"]), np.array(lum["c0"])
     c90 = np.cross(-aim, c0)
@@ -165,7 +178,14 @@ def main():
     ap.add_argument("--ab", type=int, default=8)
     ap.add_argument("--ad", type=int, default=2048)
     ap.add_argument("--procs", type=int, default=2)
+    ap.add_argument("--opening", default="0,0,0", metavar="W,L,H",
+                    help="write every web with a luminous opening W x L x H metres (ies2rad then "
+                         "makes area sources: a rectangle lit downward only for H 0, a box lit on "
+                         "every side otherwise; the tool spreads the web over its footprint); "
+                         "default points")
     args = ap.parse_args()
+    global OPENING
+    OPENING = tuple(float(x) for x in (args.opening.split(",") + ["0", "0"])[:3])
     out = args.out.resolve()
     out.mkdir(parents=True, exist_ok=True)
     binary = radiosity_binary(args.radiosity, must_exist=True)
