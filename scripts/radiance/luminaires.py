@@ -10,7 +10,8 @@ room lit only by photometric luminaires.
 2. The tool: ``radiosity solve ROOM --luminaires SCHEDULE --grid 0.8,0.5 --out DIR/solve``.
 3. Radiance at the same sensors: the room written by ``objrad.py`` from the tool's own
    materials; each luminaire by ``ies2rad -dm -i 0.01`` (with ``--opening W,L,H``, the webs carry
-   that luminous opening and ``ies2rad`` makes its area source instead) (an ``illum`` sphere of 1 cm at the
+   that luminous opening and ``ies2rad`` makes its area source instead, made ``illum``; the
+   pendant is then left out, since Radiance's openings shade each other) (an ``illum`` sphere of 1 cm at the
    photometric centre, Radiance's ``source.cal`` distribution: 0 deg horizontal along +X, 90 along
    +Y, the nadir -Z, the same local frame as the tool's), multiplied by its scale, tinted, then
    turned and moved by ``xform`` into the frame the tool reports (``radiosity info --json
@@ -123,6 +124,11 @@ def write_schedule(out: Path) -> Path:
             "back,downlight.ies,1.5,2.95,3.3,3,1.5,0,0,0.8,,,,90,1,0.9,0.75",
             "spot,spot.ies,5.5,2.8,1,1,,,,1,0,1.4,3,20,,,",
             "pendant,pendant.ies,3,2.1,2.25,1,,,,1,,,,0,,,"]
+    if any(OPENING):
+        # In Radiance an opening is a surface that shades the other luminaires (the pendant's
+        # hides a downlight from the sensors beyond it); in the tool a luminaire has no body.
+        # With openings the pendant is left out, so that both see the same lights.
+        rows.pop()
     path = out / "lights.csv"
     path.write_text("\n".join(rows) + "\n")
     return path
