@@ -47,6 +47,16 @@ pub struct LuminaireInfo {
     pub watts: [f64; 3],
 }
 
+/// The model's own sun as `info` lists it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SunInfo {
+    pub name: String,
+    /// Unit vector from the model towards the sun.
+    pub towards: [f64; 3],
+    /// Illuminance normal to its direction, lux.
+    pub lux: f64,
+}
+
 /// The scene's luminaires as the summaries list them.
 pub fn luminaires(scene: &Scene) -> Vec<LuminaireInfo> {
     (scene.luminaires.iter())
@@ -107,8 +117,12 @@ pub struct SceneInfo {
     pub bounds_max: [f32; 3],
     pub materials: Vec<MaterialInfo>,
     pub lights: Vec<LightInfo>,
-    /// Luminaires placed by `--luminaires` (empty without).
+    /// Luminaires placed by `--luminaires` or by the model itself (a glTF's point and spot
+    /// lights); empty without.
     pub luminaires: Vec<LuminaireInfo>,
+    /// The model's own sun (a glTF directional light), if it has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sun: Option<SunInfo>,
     /// What `--intersector auto` picks for this scene, and why.
     pub intersector: &'static str,
     pub intersector_reason: String,
@@ -190,6 +204,11 @@ pub fn scene_info(scene: &Scene, mesh: &Mesh, suggested: f32) -> SceneInfo {
             .collect(),
         lights: lights(scene, mesh),
         luminaires: luminaires(scene),
+        sun: scene.sun.as_ref().map(|s| SunInfo {
+            name: s.name.clone(),
+            towards: s.towards.to_array(),
+            lux: s.illuminance,
+        }),
         intersector: auto.name(),
         intersector_reason: why,
         warnings: scene.warnings.clone(),
@@ -295,6 +314,14 @@ impl std::fmt::Display for SceneInfo {
                     l.name, l.lumens, p[0], p[1], p[2], a[0], a[1], a[2], l.group, l.file
                 )?;
             }
+        }
+        if let Some(s) = &self.sun {
+            let t = s.towards;
+            writeln!(
+                f,
+                "sun            '{}': {:.0} lux from {:.3},{:.3},{:.3} (the model's directional light; lights a solve unless --sun places one)",
+                s.name, s.lux, t[0], t[1], t[2]
+            )?;
         }
         writeln!(
             f,
