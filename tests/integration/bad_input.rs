@@ -95,7 +95,7 @@ const FILES: &[Case] = &[
     ("glTF: lines only", "solve -q {c}/gltf-lines-only.gltf --out {t}/o", &["gltf-lines-only.gltf", "no polygons"]),
     ("glTF: a node cycle", "solve -q {c}/gltf-node-cycle.gltf --out {t}/o", &["gltf-node-cycle.gltf", "node 0 'tri'", "its own ancestor", "cycle"]),
     ("glTF: Draco compression required", "solve -q {c}/gltf-requires-draco.gltf --out {t}/o", &["gltf-requires-draco.gltf", "KHR_draco_mesh_compression", "does not read"]),
-    ("glTF: a spot light of negative intensity", "solve -q {c}/gltf-spot-negative-intensity.gltf --out {t}/o", &["gltf-spot-negative-intensity.gltf", "downlight", "intensity -5"]),
+    ("glTF: a spot light of negative intensity", "solve -q {c}/gltf-spot-negative-intensity.gltf --out {t}/o", &["gltf-spot-negative-intensity.gltf", "light 0 'downlight'", "intensity -5"]),
     ("glTF: a negative base colour", "solve -q {c}/gltf-base-colour-negative.gltf --out {t}/o", &["gltf-base-colour-negative.gltf", "material 0 'floor'", "base colour -0.5"]),
     ("glTF: no light", "solve -q {c}/gltf-no-light.gltf --out {t}/o", &["gltf-no-light.gltf", "no light", "--emit"]),
     ("info reads glTF the same way", "info {c}/gltf-position-nan.glb", &["gltf-position-nan.glb", "element 2 holds NaN"]),

@@ -96,11 +96,13 @@ pub fn place(
     (file, label): (&Path, &str),
     zenith: DVec3,
 ) -> Result<Placed, String> {
+    // Errors name the light as the document does, and by the name it is listed under.
+    let what = format!("light {} '{label}'", light.index());
     let colour = light.color().map(to_f64);
     let intensity = to_f64(light.intensity());
     if !(intensity.is_finite() && intensity >= 0.0) {
         return Err(format!(
-            "{label}: its intensity {intensity} is not a finite, non-negative number"
+            "{what}: its intensity {intensity} is not a finite, non-negative number"
         ));
     }
     let Some(tint) = normalise_colour(colour) else {
@@ -108,7 +110,7 @@ pub fn place(
             return Ok(Placed::Dark(format!("{label} is black")));
         }
         return Err(format!(
-            "{label}: its colour {} {} {} is not a colour (each channel finite, not negative)",
+            "{what}: its colour {} {} {} is not a colour (each channel finite, not negative)",
             colour[0], colour[1], colour[2]
         ));
     };
@@ -125,7 +127,7 @@ pub fn place(
         Kind::Directional => {
             let towards = -aim.normalize_or_zero();
             if towards == DVec3::ZERO || !towards.is_finite() {
-                return Err(format!("{label}: its node's transform has no direction"));
+                return Err(format!("{what}: its node's transform has no direction"));
             }
             return Ok(Placed::Sun(ModelSun {
                 name: label.to_string(),
@@ -146,10 +148,10 @@ pub fn place(
     let c0 = world.transform_vector3(DVec3::X);
     let frame = Frame::new(aim, 0.0, Some(c0), zenith)
         .or_else(|| Frame::new(aim, 0.0, None, zenith))
-        .ok_or_else(|| format!("{label}: its node's transform has no direction"))?;
+        .ok_or_else(|| format!("{what}: its node's transform has no direction"))?;
     let position = world.transform_point3(DVec3::ZERO);
     if !position.is_finite() {
-        return Err(format!("{label}: its node's position is not finite"));
+        return Err(format!("{what}: its node's position is not finite"));
     }
     let text = web_text(web, intensity * luminance, label);
     let photometry = parse_ies(&text, label).map_err(|e| e.to_string())?;
