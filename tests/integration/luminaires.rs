@@ -53,6 +53,47 @@ fn write(dir: &Path, name: &str, text: &str) {
     std::fs::write(dir.join(name), text).unwrap();
 }
 
+/// A black plane y = 0, 20 m square (`plane.obj`), and upward sensors at height `y` over the
+/// places (x, z) (`pts.csv`).
+fn black_plane_with_sensors(d: &Path, places: &[(f64, f64)], y: f64) {
+    write(d, "plane.mtl", "newmtl black\nKd 0 0 0\n");
+    write(
+        d,
+        "plane.obj",
+        "mtllib plane.mtl\nv -10 0 -10\nv 10 0 -10\nv 10 0 10\nv -10 0 10\nusemtl black\nf 4 3 2 1\n",
+    );
+    let mut pts = String::from("x,y,z,nx,ny,nz\n");
+    for (x, z) in places {
+        pts += &format!("{x},{y},{z},0,1,0\n");
+    }
+    write(d, "pts.csv", &pts);
+}
+
+/// `solve` of the plane lit by `schedule` into `d/out`, and its sensors: (x, y, z, lux) each.
+fn sensor_lux(d: &Path, schedule: &str, out: &str) -> Vec<(glam::DVec3, f64)> {
+    let out = d.join(out);
+    let (code, _, err) = run(&[
+        "solve",
+        d.join("plane.obj").to_str().unwrap(),
+        "--luminaires",
+        d.join(schedule).to_str().unwrap(),
+        "--grid",
+        d.join("pts.csv").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let grid = std::fs::read_to_string(out.join("grid.csv")).unwrap();
+    let mut lines = grid.lines();
+    assert!(lines.next().unwrap().starts_with("x,y,z,nx,ny,nz,lux,"));
+    lines
+        .map(|line| {
+            let f: Vec<f64> = line.split(',').map(|v| v.parse().unwrap_or(0.0)).collect();
+            (glam::DVec3::new(f[0], f[1], f[2]), f[6])
+        })
+        .collect()
+}
+
 /// The web's own bilinear value of [`asymmetric`] at (C, γ), degrees.
 fn asymmetric_at(c: f64, g: f64) -> f64 {
     let at = |c: f64, g: f64| 2000.0 * g.to_radians().cos() * (1.0 + 0.5 * c.to_radians().cos());
@@ -71,19 +112,12 @@ fn sensors_under_a_luminaire_read_the_inverse_square_law() {
     let d = dir.path();
     write(d, "iso.ies", &isotropic(1000.0));
     write(d, "asym.ies", &asymmetric());
-    write(d, "plane.mtl", "newmtl black\nKd 0 0 0\n");
-    write(
-        d,
-        "plane.obj",
-        "mtllib plane.mtl\nv -10 0 -10\nv 10 0 -10\nv 10 0 10\nv -10 0 10\nusemtl black\nf 4 3 2 1\n",
-    );
     write(d, "iso.csv", "file,x,y,z\niso.ies,0,3,0\n");
     write(
         d,
         "asym.csv",
         "file,x,y,z,aim_x,aim_y,aim_z,spin\nasym.ies,0,3,0,1,0,0,30\n",
     );
-    let mut pts = String::from("x,y,z,nx,ny,nz\n");
     let places = [
         (0.0, 0.0),
         (1.0, -1.5),
@@ -91,10 +125,7 @@ fn sensors_under_a_luminaire_read_the_inverse_square_law() {
         (-4.0, 0.0),
         (6.0, -1.5),
     ];
-    for (x, z) in places {
-        pts += &format!("{x},0.001,{z},0,1,0\n");
-    }
-    write(d, "pts.csv", &pts);
+    black_plane_with_sensors(d, &places, 0.001);
     // The asymmetric one's frame, by the schedule's conventions: C0 is +X made perpendicular
     // to the aim, then turned 30° about it, C90 = −aim × C0.
     let aim = glam::DVec3::new(1.0, -3.0, 0.0).normalize();
@@ -104,25 +135,9 @@ fn sensors_under_a_luminaire_read_the_inverse_square_law() {
     let c0 = c0 * c + c90 * s;
     let c90 = (-aim).cross(c0);
     for (schedule, web) in [("iso.csv", None), ("asym.csv", Some((aim, c0, c90)))] {
-        let out = d.join(format!("out-{schedule}"));
-        let (code, _, err) = run(&[
-            "solve",
-            d.join("plane.obj").to_str().unwrap(),
-            "--luminaires",
-            d.join(schedule).to_str().unwrap(),
-            "--grid",
-            d.join("pts.csv").to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-        ]);
-        assert_eq!(code, 0, "{err}");
-        let grid = std::fs::read_to_string(out.join("grid.csv")).unwrap();
-        let mut lines = grid.lines();
-        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-        let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
-        for line in lines {
-            let f: Vec<f64> = line.split(',').map(|v| v.parse().unwrap_or(0.0)).collect();
-            let x = glam::DVec3::new(f[col("x")], f[col("y")], f[col("z")]);
+        let sensors = sensor_lux(d, schedule, &format!("out-{schedule}"));
+        assert_eq!(sensors.len(), places.len(), "a sensor per place");
+        for (x, lux) in sensors {
             let to = x - glam::DVec3::new(0.0, 3.0, 0.0);
             let r = to.length();
             let cos = -to.y / r;
@@ -136,7 +151,6 @@ fn sensors_under_a_luminaire_read_the_inverse_square_law() {
                 }
             };
             let exact = i * cos / (r * r);
-            let lux = f[col("lux")];
             assert!(
                 (lux / exact - 1.0).abs() < 0.005,
                 "{schedule} at {x}: {lux} lux against {exact}"
@@ -283,36 +297,12 @@ fn a_luminous_opening_lights_what_is_near_it_from_its_whole_area() {
     let square = isotropic(1000.0).replace("1 1 2 0 0 0\n", "1 1 2 0.6 0.6 0\n");
     assert_ne!(square, isotropic(1000.0));
     write(d, "square.ies", &square);
-    write(d, "plane.mtl", "newmtl black\nKd 0 0 0\n");
-    write(
-        d,
-        "plane.obj",
-        "mtllib plane.mtl\nv -10 0 -10\nv 10 0 -10\nv 10 0 10\nv -10 0 10\nusemtl black\nf 4 3 2 1\n",
-    );
     write(d, "lum.csv", "file,x,y,z\nsquare.ies,0,0.3,0\n");
     let places = [(0.0, 0.0), (0.25, 0.1), (0.6, -0.2), (3.0, 0.0)];
-    let mut pts = String::from("x,y,z,nx,ny,nz\n");
-    for (x, z) in places {
-        pts += &format!("{x},0,{z},0,1,0\n");
-    }
-    write(d, "pts.csv", &pts);
-    let out = d.join("out");
-    let (code, _, err) = run(&[
-        "solve",
-        d.join("plane.obj").to_str().unwrap(),
-        "--luminaires",
-        d.join("lum.csv").to_str().unwrap(),
-        "--grid",
-        d.join("pts.csv").to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
-    let grid = std::fs::read_to_string(out.join("grid.csv")).unwrap();
-    let lux: Vec<f64> = grid
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(6).unwrap().parse().unwrap())
+    black_plane_with_sensors(d, &places, 0.0);
+    let lux: Vec<f64> = sensor_lux(d, "lum.csv", "out")
+        .iter()
+        .map(|s| s.1)
         .collect();
     // The mean over the square by the midpoint rule, 400 × 400.
     let spread = |x: f64, z: f64| {
