@@ -149,9 +149,8 @@ pub fn model_sun(
     }
     let compass = frame_of(job);
     let local = compass.to_local(sun.towards);
-    let altitude = local.z.clamp(-1.0, 1.0).asin().to_degrees();
-    let azimuth = (-local.x).atan2(-local.y).to_degrees();
-    let angles = SolarAngles::new(altitude, azimuth)?;
+    let angles = SolarAngles::from_local_dir(local)?;
+    let (altitude, azimuth) = (angles.altitude, angles.azimuth);
     let spec = SkySpec {
         sun_position: Some(angles),
         sun: Some(SunLevel::NormalIlluminance(sun.illuminance)),

@@ -69,6 +69,18 @@ impl SolarAngles {
         let (sin_a, cos_a) = self.azimuth.to_radians().sin_cos();
         DVec3::new(-sin_a * cos_h, -cos_a * cos_h, sin_h)
     }
+
+    /// The angles of a unit direction towards the sun in the local frame (x east, y north,
+    /// z up): the inverse of [`SolarAngles::local_dir`] (straight up reads azimuth 0).
+    pub fn from_local_dir(d: DVec3) -> Result<SolarAngles, Invalid> {
+        let altitude = d.z.clamp(-1.0, 1.0).asin().to_degrees();
+        let azimuth = if d.x == 0.0 && d.y == 0.0 {
+            0.0
+        } else {
+            (-d.x).atan2(-d.y).to_degrees()
+        };
+        SolarAngles::new(altitude, azimuth)
+    }
 }
 
 /// A place on the earth, in degrees.
@@ -283,6 +295,18 @@ fn cos_d(a: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn local_directions_read_back_as_their_angles() {
+        for (alt, azi) in [(45.0, 45.0), (10.0, -120.0), (80.0, 179.0), (-5.0, 0.0)] {
+            let a = SolarAngles::new(alt, azi).unwrap();
+            let b = SolarAngles::from_local_dir(a.local_dir()).unwrap();
+            assert!(
+                (b.altitude - alt).abs() < 1e-9 && (b.azimuth - azi).abs() < 1e-9,
+                "{b:?}"
+            );
+        }
+    }
 
     #[test]
     fn julian_days_of_meeus_examples() {
