@@ -9,9 +9,9 @@
 //! every patch's unshot and kept flux.
 //!
 //! **Waves.** Late in a solve shots are tiny (a few rays each), too small to feed two cores. So
-//! shooters are taken from the top of the queue in *waves* (about [`WAVE_RAYS`] rays, or
-//! [`CUBE_WAVE`] hemi-cubes), cast in parallel against the books at the start of the wave, and
-//! their hits applied in a fixed order. Picking a shooter costs O(log patches) (an indexed
+//! shooters are taken from the top of the queue in *waves* (about [`wave_rays`] rays, or
+//! [`CUBE_WAVE`] hemi-cubes), cast in parallel against the books at the start of the wave (in
+//! the order of their patches, for the cache), and their hits applied in the queue's order. Picking a shooter costs O(log patches) (an indexed
 //! binary heap, `key_heap::KeyHeap`), never O(patches). Ray waves are pipelined: while one thread applies
 //! wave k's hits, the others cast wave k + 1, which was taken off the heap before wave k's
 //! deposits reached it; its shooters are then at most one wave out of date, the books stay
@@ -32,7 +32,7 @@ use super::estimate::PatchScalars;
 use super::final_gather;
 use super::luminaire_shots;
 use super::ray_shots::{
-    apply_rays, energy_per_ray, grid_for, tasks_of, Hits, RayCaster, RayShot, Task, BACK, WAVE_RAYS,
+    apply_rays, energy_per_ray, grid_for, tasks_of, wave_rays, Hits, RayCaster, RayShot, Task, BACK,
 };
 use super::sky_shots;
 use super::stopping::{self, Progress};
@@ -250,6 +250,8 @@ struct Driver<'a, I> {
     st: State,
     /// C: the energy every ray carries (scalar W; Sec. 2).
     energy_per_ray: f64,
+    /// Rays per wave ([`wave_rays`]).
+    wave_rays: usize,
     scalars: PatchScalars,
     /// Casts the rays (the methods that cast rays).
     caster: Option<RayCaster<'a, I>>,
@@ -371,6 +373,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             hooks,
             st,
             energy_per_ray: c,
+            wave_rays: wave_rays(n),
             scalars: PatchScalars::new(mesh, materials),
             caster,
             sky: sky.map(|s| (s, bounds)),
@@ -658,7 +661,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             .cfg
             .max_rays
             .map_or(usize::MAX, |r| r.saturating_sub(samples) as usize);
-        while wave_rays < WAVE_RAYS.min(ray_cap.max(1)) {
+        while wave_rays < self.wave_rays.min(ray_cap.max(1)) {
             let Some((i, phi)) = self.st.take_shooter() else {
                 break;
             };
@@ -687,12 +690,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
         }
         let caster = self.caster.as_ref().expect("checked in Driver::new");
         let tasks = tasks_of(&wave);
-        let cast = || -> Vec<Hits> {
-            tasks
-                .par_iter()
-                .map(|t| caster.cast(&wave[t.shot], t.chunk, t.first, t.count))
-                .collect()
-        };
+        let cast = || cast_in_patch_order(caster, &wave, &tasks);
         let st = &mut self.st;
         let hits = match self.pending.take() {
             Some(p) => rayon::join(|| apply_rays(st, &p.wave, &p.tasks, &p.hits), cast).1,
@@ -733,6 +731,32 @@ impl<'a, I: Intersector> Driver<'a, I> {
             back: std::mem::take(&mut st.back),
         }
     }
+}
+
+/// A wave's tasks cast in the order of their shooters' patches, the hits handed back in task
+/// order. Patches are numbered surface by surface, so shots of nearby patches then follow
+/// one another and reuse the intersector's nodes and triangles in the cache, where the
+/// queue's order jumps across the model (measured: docs/results/pipeline-1m.md). What a
+/// task's rays meet depends only on its shot and chunk, so the order changes nothing else.
+fn cast_in_patch_order<I: Intersector>(
+    caster: &RayCaster<'_, I>,
+    wave: &[RayShot],
+    tasks: &[Task],
+) -> Vec<Hits> {
+    let mut order: Vec<u32> = (0..tasks.len() as u32).collect();
+    order.sort_by_key(|&k| (wave[tasks[k as usize].shot].patch, k));
+    let cast: Vec<Hits> = order
+        .par_iter()
+        .map(|&k| {
+            let t = &tasks[k as usize];
+            caster.cast(&wave[t.shot], t.chunk, t.first, t.count)
+        })
+        .collect();
+    let mut hits = vec![Hits::default(); tasks.len()];
+    for (&k, h) in order.iter().zip(cast) {
+        hits[k as usize] = h;
+    }
+    hits
 }
 
 #[cfg(test)]

@@ -158,3 +158,28 @@ fn two_default_cli_solves_write_identical_patch_tables() {
         );
     }
 }
+
+/// A mesh of more than 131,072 patches shoots in larger waves (a quarter of a ray per patch),
+/// cast in the order of their patches: still the same on one thread and two.
+#[test]
+fn large_meshes_shoot_larger_waves_alike_on_any_thread_count() {
+    let s = scene_builder::load_project_scene("cornell-box.obj");
+    let m = scene_builder::mesh_uniform(&s, Some(0.003));
+    let n = m.patches.len();
+    assert!(n > 8 * solve::ray_shots::WAVE_RAYS, "{n} patches");
+    let cfg = SolveSettings {
+        method: MethodKind::AdaptiveRays,
+        tolerance: 0.5,
+        final_gather: false,
+        error_target: None,
+        ..SolveSettings::default()
+    };
+    let one = solve_in(Some(1), &s, &m, &cfg);
+    // Waves of more than WAVE_RAYS rays each (the last one may be short).
+    let per_wave = one.stats.rays as f64 / one.stats.waves as f64;
+    assert!(
+        per_wave > 2.0 * solve::ray_shots::WAVE_RAYS as f64,
+        "{per_wave} rays a wave"
+    );
+    assert_same(&one, &solve_in(Some(2), &s, &m, &cfg), "2 threads");
+}
