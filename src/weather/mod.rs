@@ -50,6 +50,7 @@ mod tests;
 
 use crate::settings::Invalid;
 use crate::sky::solar::{DateTime, Site};
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
 /// The year a typical-year series is dated in (not a leap year): see the module docs.
@@ -57,6 +58,15 @@ pub const TYPICAL_YEAR: i32 = 2023;
 
 /// The year 29 February of a leap-year file is dated in.
 pub const LEAP_YEAR: i32 = 2024;
+
+/// Latitude's range, degrees.
+const LATITUDE: RangeInclusive<f64> = -90.0..=90.0;
+/// Longitude's range, degrees.
+const LONGITUDE: RangeInclusive<f64> = -180.0..=180.0;
+/// The time zone's range, hours from UTC.
+const UTC_OFFSET: RangeInclusive<f64> = -14.0..=14.0;
+/// Elevation's range, m (the EPW data dictionary's).
+const ELEVATION: RangeInclusive<f64> = -1000.0..=9999.9;
 
 /// Where the weather was recorded.
 #[derive(Clone, Debug, PartialEq)]
@@ -79,23 +89,20 @@ impl Location {
     /// Checks the ranges: |latitude| ≤ 90°, |longitude| ≤ 180°, |UTC offset| ≤ 14 h and the
     /// elevation within [−1000, 9999.9] m (the EPW data dictionary's limits).
     pub fn validate(&self) -> Result<(), Invalid> {
-        let (lat, lon, tz, elev) = (
-            self.latitude,
-            self.longitude,
-            self.utc_offset,
-            self.elevation,
-        );
-        if !(lat.abs() <= 90.0) {
-            return Invalid::err(format!("latitude {lat} is not within [-90, 90] degrees"));
-        }
-        if !(lon.abs() <= 180.0) {
-            return Invalid::err(format!("longitude {lon} is not within [-180, 180] degrees"));
-        }
-        if !(tz.abs() <= 14.0) {
-            return Invalid::err(format!("time zone {tz} is not within [-14, 14] hours"));
-        }
-        if !(-1000.0..=9999.9).contains(&elev) {
-            return Invalid::err(format!("elevation {elev} is not within [-1000, 9999.9] m"));
+        let checks = [
+            (self.latitude, LATITUDE, "latitude", "degrees"),
+            (self.longitude, LONGITUDE, "longitude", "degrees"),
+            (self.utc_offset, UTC_OFFSET, "time zone", "hours"),
+            (self.elevation, ELEVATION, "elevation", "m"),
+        ];
+        for (value, range, what, unit) in checks {
+            if !range.contains(&value) {
+                return Invalid::err(format!(
+                    "{what} {value} is not within [{}, {}] {unit}",
+                    range.start(),
+                    range.end()
+                ));
+            }
         }
         Ok(())
     }

@@ -3,7 +3,7 @@
 
 use super::{
     check_date, day_of_year, malformed, month_name, not_negative, number, quote, whole, Hour,
-    Location, Weather, WeatherError, WeatherSource,
+    Location, Weather, WeatherError, WeatherSource, ELEVATION, LATITUDE, LONGITUDE, UTC_OFFSET,
 };
 use std::fmt::Write;
 
@@ -98,25 +98,25 @@ fn location(values: &[&str; 6]) -> Result<Location, (usize, String)> {
     let checks = [
         (
             2,
-            latitude.abs() <= 90.0,
+            LATITUDE.contains(&latitude),
             "latitude",
             "[-90, 90] degrees north",
         ),
         (
             3,
-            west.abs() <= 180.0,
+            LONGITUDE.contains(&west),
             "longitude",
             "[-180, 180] degrees west",
         ),
         (
             4,
-            meridian.abs() <= 210.0,
+            UTC_OFFSET.contains(&(meridian / 15.0)),
             "time_zone",
             "[-210, 210] degrees west (14 hours either side of UTC)",
         ),
         (
             5,
-            (-1000.0..=9999.9).contains(&elevation),
+            ELEVATION.contains(&elevation),
             "site_elevation",
             "[-1000, 9999.9] m",
         ),
