@@ -28,7 +28,8 @@
 //! buildings), [`grid`] (the sensor grid of a daylight study: placement, CSV, figures, plan),
 //! [`photometry`] (luminaire files: IES LM-63 and EULUMDAT), [`luminaire`] (placed
 //! luminaires: position, aiming frame, intensity toward a direction, the `--luminaires`
-//! schedule).
+//! schedule), [`weather`] (weather files, EPW and Radiance's `.wea`: an hourly series of
+//! irradiance at a place, for annual daylight).
 //! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
@@ -57,5 +58,6 @@ pub mod scene;
 pub mod settings;
 pub mod sky;
 pub mod solve;
+pub mod weather;
 
 pub use error::Error;
