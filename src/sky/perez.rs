@@ -213,9 +213,9 @@ impl PerezParameters {
         PerezParameters(p)
     }
 
-    /// Perez 1993, eq. 1: the relative luminance lv(ζ, γ) = (1 + a e^(b / cos ζ)) (1 + c e^(d γ)
-    /// + e cos² γ) of a sky element at zenith angle ζ and angle γ from the sun, given as
-    /// cos ζ and γ (radians). Never negative (`gendaymtx` clamps a negative patch to 0) and
+    /// Perez 1993, eq. 1: the relative luminance
+    /// lv(ζ, γ) = (1 + a e^(b / cos ζ)) (1 + c e^(d γ) + e cos² γ) of a sky element at zenith
+    /// angle ζ and angle γ from the sun, given as cos ζ and γ (radians). Never negative (`gendaymtx` clamps a negative patch to 0) and
     /// finite: cos ζ is taken ≥ 10⁻³, so the horizon itself is the limit from above.
     pub fn relative_luminance(&self, cos_zeta: f64, gamma: f64) -> f64 {
         let [a, b, c, d, e] = self.0;
