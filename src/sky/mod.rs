@@ -4,7 +4,10 @@
 //! distribution ([`cie`]: uniform, CIE overcast, CIE clear), the sun's position ([`solar`]: NOAA's
 //! algorithm) and disc ([`sun`]), the ground glow below the horizon, the model's orientation
 //! ([`compass`]), the daylight flags' settings and their check ([`settings`]) and the cut of all of it into directional pieces a shooter can fire parallel
-//! rays from ([`tregenza`], [`piece`]). It follows the conventions of Radiance's `gensky`, so a
+//! rays from ([`tregenza`], [`piece`]). For annual daylight, the sky of each hour of a weather
+//! file as Radiance's `gendaymtx` makes it: the Perez all-weather sky and luminous efficacy
+//! ([`perez`]) over the Reinhart patches ([`reinhart`]), per hour and for a year of hours
+//! ([`matrix`]). It follows the conventions of Radiance's `gensky`, so a
 //! scene can be checked against Radiance:
 //!
 //! - the zenith parameter L_z is `gensky -b` (in cd/m² here, W/sr/m² there: divide by 179);
@@ -28,7 +31,10 @@
 
 pub mod cie;
 pub mod compass;
+pub mod matrix;
+pub mod perez;
 pub mod piece;
+pub mod reinhart;
 pub mod settings;
 pub mod solar;
 pub mod sun;
@@ -36,6 +42,7 @@ pub mod tregenza;
 
 pub use cie::SkyKind;
 pub use compass::{Compass, DEFAULT_NORTH, DEFAULT_ZENITH};
+pub use matrix::{Hour, Sampling, SkyMatrix, SkyOptions, SkyVector, SkyVectors, SunBeam, SunMode};
 pub use piece::{PieceKind, SkyPiece};
 pub use settings::{SkySettings, SunSetting};
 pub use solar::{DateTime, Site, SolarAngles};
