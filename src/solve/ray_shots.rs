@@ -31,9 +31,9 @@ pub const MAX_WAVE_RAYS: usize = 1 << 20;
 /// ray per patch on larger meshes, up to [`MAX_WAVE_RAYS`]. It depends on the mesh alone, so
 /// results do not depend on threads. A wave's shots are cast in the order of their patches
 /// (`driver`), and the shots of a larger wave lie nearer one another: on the 1 M-patch
-/// building, waves of 262,144 rays shot in 0.61 of the time of waves of 32,768 (cache reuse
-/// in the intersector and less waiting between waves), for 0.5 % more rays
-/// (docs/results/pipeline-1m.md).
+/// building the shooting takes 0.93 of the time of waves of 32,768 rays on an idle machine and
+/// 0.61 on a shared one (cache reuse in the intersector, less waiting between waves), for
+/// 0.5 % more rays (docs/results/pipeline-1m.md).
 pub fn wave_rays(patches: usize) -> usize {
     (patches / 4).clamp(WAVE_RAYS, MAX_WAVE_RAYS)
 }
