@@ -58,6 +58,7 @@ pub mod scene;
 pub mod settings;
 pub mod sky;
 pub mod solve;
+pub mod text;
 pub mod weather;
 
 pub use error::Error;

@@ -327,7 +327,7 @@ pub fn read(path: &Path) -> Result<Photometry, PhotometryError> {
         file: file.clone(),
         source,
     })?;
-    let text = decode(&bytes);
+    let text = crate::text::decode(&bytes);
     let ext = path
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
@@ -336,15 +336,6 @@ pub fn read(path: &Path) -> Result<Photometry, PhotometryError> {
         Some("ldt") => parse_ldt(&text, &file),
         _ if first_line_says_ies(&text) => parse_ies(&text, &file),
         _ => Err(PhotometryError::UnknownFormat { file }),
-    }
-}
-
-/// The file's text: UTF-8 as it is, anything else byte by byte as Latin-1 (every byte is a
-/// Latin-1 character, so this never fails and loses nothing).
-fn decode(bytes: &[u8]) -> String {
-    match std::str::from_utf8(bytes) {
-        Ok(s) => s.to_string(),
-        Err(_) => bytes.iter().map(|&b| char::from(b)).collect(),
     }
 }
 

@@ -250,23 +250,16 @@ impl Weather {
         Ok(weather)
     }
 
-    /// Parses a file's bytes in the given format; `name` names the file in messages. The text
-    /// must be UTF-8 (weather files are ASCII); a byte-order mark and CRLF line ends are
-    /// accepted.
+    /// Parses a file's bytes in the given format; `name` names the file in messages. Bytes
+    /// that are not UTF-8 are read as Latin-1 ([`crate::text::decode`]: an older EPW names
+    /// "Zürich" so); a byte-order mark and CRLF line ends are accepted.
     pub fn from_bytes(
         bytes: &[u8],
         name: &str,
         source: WeatherSource,
     ) -> Result<Weather, WeatherError> {
-        let text = std::str::from_utf8(bytes).map_err(|e| {
-            let at = e.valid_up_to();
-            let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
-            malformed(
-                name,
-                line,
-                format!("byte 0x{:02x} is not UTF-8 text", bytes[at]),
-            )
-        })?;
+        let text = crate::text::decode(bytes);
+        let text = text.as_str();
         match source {
             WeatherSource::Epw => Weather::parse_epw(text, name),
             WeatherSource::Wea => Weather::parse_wea(text, name),
