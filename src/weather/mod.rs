@@ -49,6 +49,7 @@ mod wea;
 mod tests;
 
 use crate::settings::Invalid;
+use crate::sky::matrix::Hour as SkyHour;
 use crate::sky::solar::{DateTime, Site};
 use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
@@ -298,6 +299,19 @@ impl Weather {
     /// whole number of hours is written exactly (`epw2wea` truncates it to whole hours).
     pub fn to_wea_string(&self) -> String {
         wea::write(self)
+    }
+
+    /// Each hour as its sky is made ([`crate::sky::matrix`]), the way `gendaymtx` reads a
+    /// weather file's line: the hour's centre in local standard time, the sun by `gendaymtx`'s
+    /// own formulas, the dew point its default (a `.wea` has none; with the Chicago TMY3
+    /// file's own dew points the skies agree no better with its illuminances), so that the
+    /// hourly skies are the ones Radiance's annual methods see from `epw2wea`'s file.
+    pub fn sky_hours(&self) -> Result<Vec<SkyHour>, Invalid> {
+        let site = self.location.site();
+        let offset = self.location.utc_offset;
+        (self.hours.iter())
+            .map(|h| SkyHour::gendaymtx(&site, offset, h.month, h.day, h.hour, h.dni, h.dhi))
+            .collect()
     }
 }
 

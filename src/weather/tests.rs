@@ -629,3 +629,52 @@ fn reads_the_epw_named_by_radiosity_epw() {
     let back = Weather::parse_wea(&w.to_wea_string(), "written.wea").unwrap();
     assert_eq!(back.len(), w.len());
 }
+
+/// The hours' skies (Perez, through `gendaymtx`'s reading of a line): dark hours give no
+/// light, a daylit hour's diffuse and direct illuminance come out of its irradiances.
+#[test]
+fn each_hour_gives_its_sky() {
+    let w = Weather::parse_wea(WEA, "weather.wea").unwrap();
+    let hours = w.sky_hours().unwrap();
+    assert_eq!(hours.len(), w.len());
+    let vectors = crate::sky::matrix::SkyVectors::new(Default::default()).unwrap();
+    let night = vectors.hour(&hours[0]).unwrap();
+    assert!(night.radiance.iter().all(|&r| r == 0.0));
+    // 21 June, 12:30 in Chicago: the sun high in the south, DNI 850 W/m², DHI 120 W/m².
+    let noon = vectors.hour(&hours[1]).unwrap();
+    assert!(hours[1].sun.altitude > 60.0, "{:?}", hours[1].sun);
+    assert!(noon.direct_illuminance > 850.0 * 80.0 && noon.direct_illuminance < 850.0 * 115.0);
+    assert!(noon.diffuse_illuminance > 120.0 * 90.0 && noon.diffuse_illuminance < 120.0 * 150.0);
+}
+
+/// A real EPW's global horizontal illuminance against the Perez model's from the same hour's
+/// irradiances (diffuse + direct normal × sin h), hour by hour:
+/// `RADIOSITY_EPW=path cargo test --release --lib weather -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn perez_horizontal_illuminance_against_the_epw() {
+    let Ok(path) = std::env::var("RADIOSITY_EPW") else {
+        return;
+    };
+    let w = Weather::read(&path).unwrap();
+    let hours = w.sky_hours().unwrap();
+    let vectors = crate::sky::matrix::SkyVectors::new(Default::default()).unwrap();
+    let (mut sum_model, mut sum_file, mut rel, mut n) = (0.0, 0.0, 0.0, 0usize);
+    for (h, sky) in w.iter().zip(&hours) {
+        let Some(file) = h.ghi_lux.filter(|&e| e > 100.0) else {
+            continue;
+        };
+        let v = vectors.hour(sky).unwrap();
+        let sin_h = sky.sun.altitude.to_radians().sin().max(0.0);
+        let model = v.diffuse_illuminance + v.direct_illuminance * sin_h;
+        sum_model += model;
+        sum_file += file;
+        rel += (model - file).abs() / file;
+        n += 1;
+    }
+    println!(
+        "{path}: {n} hours over 100 lux: annual sum model/file {:.4}, mean |hourly difference| {:.2} %",
+        sum_model / sum_file,
+        100.0 * rel / n as f64
+    );
+}
