@@ -610,14 +610,20 @@ fn damaged_files_never_panic() {
     }
 }
 
+/// The EPW named by `RADIOSITY_EPW` (a real file, tried by hand), and its path.
+fn epw_from_env() -> Option<(String, Weather)> {
+    let path = std::env::var("RADIOSITY_EPW").ok()?;
+    let w = Weather::read(&path).unwrap();
+    Some((path, w))
+}
+
 /// A real EPW read by hand: `RADIOSITY_EPW=path cargo test --release --lib weather -- --ignored`.
 #[test]
 #[ignore]
 fn reads_the_epw_named_by_radiosity_epw() {
-    let Ok(path) = std::env::var("RADIOSITY_EPW") else {
+    let Some((path, w)) = epw_from_env() else {
         return;
     };
-    let w = Weather::read(&path).unwrap();
     let (dni, dhi): (f64, f64) = (w.iter().map(|h| h.dni).sum(), w.iter().map(|h| h.dhi).sum());
     let daylit = w.iter().filter(|h| h.is_daylit()).count();
     println!(
@@ -653,10 +659,9 @@ fn each_hour_gives_its_sky() {
 #[test]
 #[ignore]
 fn perez_horizontal_illuminance_against_the_epw() {
-    let Ok(path) = std::env::var("RADIOSITY_EPW") else {
+    let Some((path, w)) = epw_from_env() else {
         return;
     };
-    let w = Weather::read(&path).unwrap();
     let hours = w.sky_hours().unwrap();
     let vectors = crate::sky::matrix::SkyVectors::new(Default::default()).unwrap();
     let (mut sum_model, mut sum_file, mut rel, mut n) = (0.0, 0.0, 0.0, 0usize);
