@@ -112,8 +112,8 @@ impl Hour {
 /// as 1 March).
 pub fn day_of_year(month: u32, day: u32) -> Result<u32, Invalid> {
     const FIRST: [u32; 12] = [0, 31, 59, 90, 120, 151, 181, 212, 243, 273, 304, 334];
-    const LEN: [u32; 12] = [31, 29, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
-    if !(1..=12).contains(&month) || day < 1 || day > LEN[month as usize - 1] {
+    // Any leap year: 29 February is a date here.
+    if !(1..=12).contains(&month) || day < 1 || day > super::solar::days_in_month(2024, month) {
         return Invalid::err(format!("month {month}, day {day} is not a date"));
     }
     Ok(FIRST[month as usize - 1] + day)

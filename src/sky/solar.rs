@@ -213,7 +213,8 @@ fn split_offset(s: &str) -> Option<(&str, f64)> {
     Some((clock.trim_end(), sign * hours))
 }
 
-fn days_in_month(year: i32, month: u32) -> u32 {
+/// The days in `month` (1–12) of `year` (Gregorian leap years).
+pub(crate) fn days_in_month(year: i32, month: u32) -> u32 {
     let leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
     match month {
         2 if leap => 29,

@@ -376,11 +376,7 @@ fn not_negative(value: f64, what: &str) -> Result<f64, String> {
 
 /// The days in `month` (1–12) of a year that has 29 February (the most a file may give).
 fn days_in_month(month: u32) -> u32 {
-    match month {
-        2 => 29,
-        4 | 6 | 9 | 11 => 30,
-        _ => 31,
-    }
+    crate::sky::solar::days_in_month(LEAP_YEAR, month)
 }
 
 /// Checks a month and day (29 February allowed).
