@@ -11,11 +11,12 @@
 //! **Waves.** Late in a solve shots are tiny (a few rays each), too small to feed two cores. So
 //! shooters are taken from the top of the queue in *waves* (about [`wave_rays`] rays, or
 //! [`CUBE_WAVE`] hemi-cubes), cast in parallel against the books at the start of the wave (in
-//! the order of their patches, for the cache), and their hits applied in the queue's order. Picking a shooter costs O(log patches) (an indexed
-//! binary heap, `key_heap::KeyHeap`), never O(patches). Ray waves are pipelined: while one thread applies
-//! wave k's hits, the others cast wave k + 1, which was taken off the heap before wave k's
-//! deposits reached it; its shooters are then at most one wave out of date, the books stay
-//! exact and the order stays fixed.
+//! the order of their patches, for the cache), and their hits applied in the queue's order.
+//! Picking a shooter costs O(log patches) (an indexed binary heap, `key_heap::KeyHeap`), never
+//! O(patches). Ray waves are pipelined: while one thread applies wave k's hits, the others
+//! cast wave k + 1, which was taken off the heap before wave k's deposits reached it; its
+//! shooters are then at most one wave out of date, the books stay exact and the order stays
+//! fixed.
 //!
 //! **Reproducible.** Every random number comes from (seed, shot, chunk); a wave's composition
 //! depends on the books and the settings only; the hybrid's switch on counted work (by
