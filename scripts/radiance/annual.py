@@ -12,10 +12,11 @@ the tool's annual output with it.
 2. **Sky matrices** (``gendaymtx``, visible radiance ``-O0``, a white sky ``-c 1 1 1``, the
    ground ``-g RHO``, Reinhart subdivision ``-m MF``, default 1: Tregenza's 145 patches plus
    the ground, ground first, the tool's patch order):
-   ``gendaymtx -m MF -c 1 1 1 -O0 -g RHO RHO RHO -of W.wea > sky.smx`` (sky and sun in the patches) and
-   ``gendaymtx -m MF -c 1 1 1 -O0 -g RHO RHO RHO -of -d -D suns.rad -M suns.txt W.wea > sun.smx`` (the
-   sun alone in the patches, and every hour's sun as a 0.533 deg ``light`` source at its exact
-   position, named ``solarN`` with N the minutes from 1 Jan 0:00 to the hour's centre). The
+   ``gendaymtx -m MF -c 1 1 1 -O0 -g RHO RHO RHO -of W.wea > sky.smx`` (sky and sun in the
+   patches) and ``gendaymtx -m MF -c 1 1 1 -O0 -g RHO RHO RHO -of -d -D suns.rad -M suns.txt
+   W.wea > sun.smx`` (the sun alone in the patches, and every hour's sun as a 0.533 deg
+   ``light`` source at its exact position, named ``solarN`` with N the minutes from 1 Jan 0:00
+   to the hour's centre). The
    sky matrix is RGB radiance in W/sr/m^2 of visible light (Radiance's 179 lm/W): the hourly
    values are turned into lux at the end, lux = 179 (0.265 R + 0.670 G + 0.065 B) (the tool's
    and Radiance's photopic weights). ``-O0`` rather than ``-O1`` (solar radiance) because the
@@ -678,7 +679,7 @@ def align_hours(tool_hours: np.ndarray, notes: list) -> np.ndarray:
     return idx
 
 
-def read_tool(tool_dir: Path, n_sensors: int, notes: list):
+def read_tool(tool_dir: Path, notes: list):
     """The tool's annual output as full-year (8760, sensors) arrays, its sensors and CPU."""
     ann = tool_dir / "annual"
     pts, nrm, _ = daylight.read_points_csv(tool_dir / "grid.csv")
@@ -728,7 +729,7 @@ def compare(ref_dir: Path, tool_dir: Path, args) -> dict:
     with open(ref_dir / "sensors.csv", newline="") as f:
         indoor = np.array([float(r["indoor"]) != 0 for r in csv.DictReader(f)])
     notes = []
-    lux, sun, tpts, _, idx, tool_cpu = read_tool(tool_dir, len(pts), notes)
+    lux, sun, tpts, _, idx, tool_cpu = read_tool(tool_dir, notes)
     if args.tool_cpu is not None:
         tool_cpu = args.tool_cpu
     if tpts.shape != pts.shape or not np.allclose(tpts, pts, atol=1e-4):
@@ -822,7 +823,8 @@ def print_compare(c: dict):
           f"{pct(h.get('aggregate_signed_error'))}); occupied hours only: mean "
           f"{pct(ho.get('mean_relative_error'))}")
     print(f"  direct sun, {d.get('sensor_hours', 0)} sensor-hours > {LIT_LUX:g} lux: mean "
-          f"{pct(d.get('mean_relative_error'))}, aggregate {pct(d.get('aggregate_relative_error'))}")
+          f"{pct(d.get('mean_relative_error'))}, aggregate "
+          f"{pct(d.get('aggregate_relative_error'))}")
     t, r, df = c["metrics_tool"], c["metrics_radiance"], c["differences_points"]
     print(f"  {'':<22}{'tool':>10}{'Radiance':>10}{'diff':>10}")
     for name, k in (("sDA300/50% %", "sda300_50"), ("ASE1000,250h %", "ase1000_250"),
@@ -854,7 +856,12 @@ def print_markdown(paths):
               f"{t['ase1000_250']:.1f} / {r['ase1000_250']:.1f} | "
               f"{d['udi_fell_short']:+.2f} / {d['udi_useful']:+.2f} / {d['udi_exceeded']:+.2f} | "
               f"{pct(nz.get('mean_relative_error'))} | {tcpu} / {cpu['radiance']:.0f} s | "
-              f"{'all' if all(c['meets'].values()) else ', '.join(k for k, v in c['meets'].items() if not v) + ' missed'} |")
+              f"{bars_cell(c['meets'])} |")
+
+
+def bars_cell(meets: dict) -> str:
+    missed = [k for k, v in meets.items() if not v]
+    return "all met" if not missed else "missed: " + ", ".join(missed)
 
 
 # --------------------------------------------------------------------------------------------
