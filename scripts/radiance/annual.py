@@ -56,6 +56,14 @@ the tool's annual output with it.
    (fell short), in [100, 3000] (useful), above 3000 (exceeded), averaged over the sensors.
    Sensors marked ``indoor`` 0 in a tool ``grid.csv`` are left out of the metrics.
 
+Settings (``--ab 12 --ad 65536``, ``-lw 0.5/ad``, no ambient cache, 2 runs by default),
+measured on the side-lit room (24 sensors, Chicago TMY3): the mean occupied illuminance is
+3,141 lux at ``-ab 8``, 3,153 at ``-ab 12`` and at ``-ab 16`` (``-lw`` at 0.5/ad makes
+Russian roulette, so a deeper ``-ab`` costs nothing); the reference's noise (mean relative
+error of the mean of 2 runs) is 0.80 % at ``-ad 65536`` (27 CPU s) and 0.63 % at 131072 (53 CPU
+s), against 1.8 % at 16384 and 3.9 % at 4096. Hours checked against ``gendaylit`` + ``rtrace
+-ab 12``: the room's mean within 0.2-2 %, the direct sun at every sensor within 0.02 %.
+
 Sensors: ``--sensors CSV`` (the tool's ``grid.csv`` or any CSV with x,y,z,nx,ny,nz) or
 ``--grid HEIGHT,SPACING`` (``daylight.py``'s ``make_grid`` rule: a lattice over the faces of a
 ``floor`` material, facing up; points inside solids dropped).
@@ -172,6 +180,14 @@ class Runner:
         if res.returncode != 0:
             sys.exit(f"failed: {shlex.join(map(str, cmd))}\n{res.stderr.decode()}")
         return out
+
+    def oconv(self, files: list, octree: Path) -> Path:
+        """``common.oconv``, timed as a step."""
+        t0, c0 = time.perf_counter(), children_cpu()
+        oconv(self.bin, self.env, files, octree)
+        self.steps.append(Step("oconv", f"oconv -f {' '.join(Path(f).name for f in files)} > "
+                               f"{octree.name}", time.perf_counter() - t0, children_cpu() - c0))
+        return octree
 
     def seconds(self) -> dict:
         """CPU and wall seconds per kind of step (the name up to a ``#``) and in total."""
@@ -393,7 +409,7 @@ def direct_sun(run: Runner, args, model_rad: Path, pts, nrm, suns_rad: Path, mod
             f.write(f"void light {n}\n0\n0\n3 {rad:.6g} {rad:.6g} {rad:.6g}\n\n"
                     f"{n} source sun_{n}\n0\n0\n4 {d[0]:.9g} {d[1]:.9g} {d[2]:.9g} 0.5330\n\n")
     (run.workdir / "suns-up.txt").write_text("".join(n + "\n" for n in up))
-    octree = oconv(run.bin, run.env, [kept, model_rad], run.workdir / "sun.oct")
+    octree = run.oconv([kept, model_rad], run.workdir / "sun.oct")
     cmd = ["rcontrib", "-h", "-faf", "-I+", "-V+", "-n", args.procs, "-ab", 0, "-lr", -12,
            "-lw", "1e-9", "-dt", 0, "-dc", 1, "-ds", 0, "-dj", 0, "-dr", 0,
            "-M", run.workdir / "suns-up.txt", octree.name]
@@ -451,7 +467,7 @@ def run_reference(args, out: Path):
     model_rad = out / "model.rad"
     objrad.write_rad(model, model_rad)
     (out / "skyglow.rad").write_text(SKYGLOW)
-    sky_oct = oconv(run.bin, run.env, [out / "skyglow.rad", model_rad], out / "sky.oct")
+    sky_oct = run.oconv([out / "skyglow.rad", model_rad], out / "sky.oct")
 
     # The direct sun: exact, no noise.
     sun_hourly, sun_info = direct_sun(run, args, model_rad, pts_l, nrm_l, out / "suns.rad",
