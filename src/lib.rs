@@ -33,6 +33,7 @@
 //! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
+pub mod annual;
 pub mod bench;
 pub mod compare;
 pub mod container;

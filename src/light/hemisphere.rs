@@ -174,9 +174,9 @@ impl<I: Intersector> Kernel<'_, I> {
                     };
                     *chc += seen.through * (sub.ch[c] + lit) / x_count as f64;
                 }
-            } else if seen.hit.is_none() {
+            } else if seen.hit.is_none() && self.sky.first_escapes {
                 let w = seen.through / x_count as f64;
-                add_to(&mut g.ch, self.sky.sky_channel, sub.v, w);
+                add_to(&mut g.ch, self.sky.channel_of(dir), sub.v, w);
             }
         }
         g.h += sum / x_count as f64;
@@ -281,7 +281,7 @@ impl<I: Intersector> Kernel<'_, I> {
             Rgb::ZERO
         };
         acc.v += seen.panes + w * l;
-        add_to(&mut acc.ch, self.sky.sky_channel, l, w);
+        add_to(&mut acc.ch, self.sky.channel_of(dir), l, w);
         if let Some(sun) = self.sky.sun() {
             acc.rays += 1;
             let l = self.sun_sample(&from, sun, (rng.gen(), rng.gen()));

@@ -102,6 +102,55 @@ impl<'a, I: Intersector> LightAt<'a, I> {
         }
     }
 
+    /// The light of a daylight-coefficient solve ([`crate::sky::Sky::coefficients`]): `b` and
+    /// its light `channels` (the ground's, then each sky patch's), for
+    /// [`LightAt::sensor_coefficients`]. The gathers' own rays that leave the model count in
+    /// no channel there: the sensors sample their direct view of each patch themselves.
+    pub fn for_coefficients(
+        mesh: &'a Mesh,
+        materials: &[Material],
+        isect: &'a I,
+        b: &'a [[f64; 3]],
+        channels: &'a [super::LightChannel],
+        sky: &'a Sky,
+    ) -> Self {
+        let (e, rho) = emission_and_reflectance(mesh, materials);
+        let sol = Solved {
+            e: Cow::Owned(e),
+            rho: Cow::Owned(rho),
+            b,
+            channels,
+            group: None,
+        };
+        let mut kernel = Kernel::new(mesh, materials, isect, sol, Some(sky));
+        kernel.sky.first_escapes = false;
+        LightAt {
+            kernel,
+            facing: (0..mesh.patches.len()).map(|_| OnceLock::new()).collect(),
+        }
+    }
+
+    /// The daylight coefficients of sensors `(point, facing)`
+    /// ([`super::coefficients`]): a gather of `rays` rays each over the solution's channels,
+    /// and `rays_per_patch` rays at each sky patch (and ground patch) the sensor faces; sensor k
+    /// draws from (seed, [`Stream::Sensors`], k). Built by [`LightAt::for_coefficients`].
+    pub fn sensor_coefficients(
+        &self,
+        sensors: &[(Vec3, Vec3)],
+        rays: usize,
+        rays_per_patch: usize,
+        seed: u64,
+    ) -> Vec<super::coefficients::SensorCoefficients> {
+        self.kernel
+            .sensor_coefficients(sensors, rays, rays_per_patch, seed)
+    }
+
+    /// The direct sun at each sensor for each direction of `dirs` ([`super::coefficients`]):
+    /// cos θ × the glazing's `luma`-weighted transmittance, 0 in shadow; rows by direction.
+    pub fn sun_view(&self, sensors: &[(Vec3, Vec3)], dirs: &[Vec3], luma: Rgb) -> Vec<f32> {
+        self.kernel.sun_view(sensors, dirs, luma)
+    }
+
     /// Whether some emitter could light `patch`: the emitters' own test, a cluster with a
     /// part in front of the patch's plane while the patch is not wholly behind it
     /// (`Emitters::draw_for`). When none can — a ceiling beside its flush lamps — light samples

@@ -47,6 +47,7 @@
 //! (seed, `solve::Stream`, item) — a patch, a sensor, a pixel, a polygon — so results do not
 //! depend on the thread count.
 
+pub mod coefficients;
 pub mod direct;
 pub mod emitters;
 pub mod gather;
@@ -82,6 +83,15 @@ pub struct LightChannel {
 pub const SKY_CHANNEL: &str = "(sky)";
 /// The per-light channel of the sun.
 pub const SUN_CHANNEL: &str = "(sun)";
+/// Daylight coefficients ([`crate::sky::Sky::coefficients`]): the ground's channel, each sky
+/// patch's following it in the patches' order ([`sky_patch_channel`]).
+pub const GROUND_CHANNEL: &str = "(ground)";
+
+/// The channel name of daylight-coefficient sky patch `k` (0-based): `(sky k+1)`, numbered as
+/// the rows of Radiance's sky matrices, the ground being 0.
+pub fn sky_patch_channel(k: usize) -> String {
+    format!("(sky {})", k + 1)
+}
 
 /// The scalar the solver ranks and stops by: the mean of the three channels
 /// (`solve::scalar`'s, in that order).

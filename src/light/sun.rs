@@ -4,7 +4,9 @@
 //! (through glazing, tinted by it), L_sun·Ω_sun·cos θ each.
 
 use super::gather::{latin, stratified_var, Gathered, Spot};
-use super::{add_to, scalar, Kernel, LightChannel, Origin, Rgb, SKY_CHANNEL, SUN_CHANNEL};
+use super::{
+    add_to, scalar, Kernel, LightChannel, Origin, Rgb, GROUND_CHANNEL, SKY_CHANNEL, SUN_CHANNEL,
+};
 use crate::intersect::{Intersector, Ray};
 use crate::sky::{Sky, Sun};
 use glam::Vec3;
@@ -19,6 +21,14 @@ pub(crate) struct SkyLight<'a> {
     pub sun_weight: f64,
     pub sky_channel: Option<usize>,
     pub sun_channel: Option<usize>,
+    /// Daylight coefficients: the ground's channel, each sky patch's after it
+    /// ([`crate::light::GROUND_CHANNEL`]); rays that leave go to the channel of the patch
+    /// they look into.
+    pub patch_channels: Option<usize>,
+    /// Whether the rays a gather casts from its own point and that leave the model count in
+    /// the channels (false where the caller samples that direct view of the sky itself,
+    /// patch by patch: the sensors' daylight coefficients).
+    pub first_escapes: bool,
 }
 
 impl<'a> SkyLight<'a> {
@@ -32,6 +42,18 @@ impl<'a> SkyLight<'a> {
             sun_weight: 1.0,
             sky_channel: channel(SKY_CHANNEL),
             sun_channel: channel(SUN_CHANNEL),
+            patch_channels: channel(GROUND_CHANNEL)
+                .filter(|_| sky.is_some_and(|s| s.subdivision().is_some())),
+            first_escapes: true,
+        }
+    }
+
+    /// The channel of the light a ray that leaves the model along `dir` sees: its sky
+    /// patch's (or the ground's) for daylight coefficients, else the sky's.
+    pub fn channel_of(&self, dir: Vec3) -> Option<usize> {
+        match (self.patch_channels, self.sky) {
+            (Some(first), Some(sky)) => sky.coefficient_channel(dir).map(|c| first + c),
+            _ => self.sky_channel,
         }
     }
 

@@ -19,6 +19,7 @@
 //! - [`hooks`]: what the run plugs into the solver (reference, per-light channels,
 //!   checkpoints, resume, Ctrl-C).
 
+pub mod annual;
 pub mod daylight;
 pub mod hooks;
 pub mod outputs;

@@ -296,11 +296,7 @@ pub fn solve(
 /// The solve's sky, for the stages after the solve (the solver builds its own from the same
 /// settings).
 pub fn sky(job: &SolveJob) -> Option<Sky> {
-    job.settings
-        .solve
-        .sky
-        .as_ref()
-        .and_then(|s| Sky::new(s).ok())
+    job.settings.solve.build_sky().ok().flatten()
 }
 
 impl Solved<'_> {

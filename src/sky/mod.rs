@@ -76,6 +76,16 @@ pub enum SkyLevel {
     Gensky,
 }
 
+/// A sky of daylight coefficients ([`Sky::coefficients`]): the Reinhart subdivision MF and,
+/// to check a channel against a plain solve, the one column lit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct CoefficientSky {
+    pub subdivision: u32,
+    /// Light only this column (0 the ground, 1 + k sky patch k); `None`: all at radiance 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub only: Option<usize>,
+}
+
 /// What a sky is made of: the settings, checked by [`SkySpec::check`] (which [`Sky::new`]
 /// and [`crate::solve::SolveSettings::check`] call). The flags are turned into one by
 /// [`SkySettings::spec`].
@@ -127,6 +137,8 @@ pub struct Sky {
     /// ρ_g E_h / π, W/sr/m².
     ground_radiance: f64,
     pieces: Vec<SkyPiece>,
+    /// What a daylight-coefficient sky is ([`Sky::coefficients`]).
+    coefficients: Option<CoefficientSky>,
 }
 
 impl Sky {
@@ -159,9 +171,76 @@ impl Sky {
             ratio,
             ground_radiance: spec.ground_reflectance * e_total / PI,
             pieces: Vec::new(),
+            coefficients: None,
         };
         sky.pieces = sky.build_pieces(&bands, &q);
         Ok(sky)
+    }
+
+    /// The sky of daylight coefficients (Tregenza 1983; Radiance's `rfluxmtx` sky): every
+    /// direction of the sky and of the ground at radiance 1 W/sr/m², cut into the
+    /// subdivision's Reinhart patches ([`reinhart::patches`]; MF 1 is Tregenza's 145) and the
+    /// ground's mirrored Tregenza patches, with no sun. A solve under it with one light
+    /// channel per patch and one for the ground ([`Sky::coefficient_channel`]) holds, in each
+    /// channel, the model's response to that patch alone at unit radiance: any sky of those
+    /// patches (an hour of a weather file, [`matrix::SkyVectors`]) is then a weighted sum of
+    /// the channels. With `only`, that one column alone is lit (0 the ground, 1 + k sky patch
+    /// k): the plain solve a channel must agree with. Orientation from `spec`'s zenith and
+    /// north; its other fields are not used.
+    pub fn coefficients(spec: &SkySpec, c: &CoefficientSky) -> Result<Sky, Invalid> {
+        let compass = Compass::new(spec.zenith, spec.north)?;
+        let patches = reinhart::patches(c.subdivision)?;
+        if let Some(k) = c.only.filter(|&k| k > patches.len()) {
+            return Invalid::err(format!(
+                "sky column {k} is past the last of MF {} ({})",
+                c.subdivision,
+                patches.len()
+            ));
+        }
+        let lit = |column: usize| {
+            if c.only.is_none_or(|k| k == column) {
+                1.0
+            } else {
+                0.0
+            }
+        };
+        let sky = patches
+            .iter()
+            .enumerate()
+            .map(|(k, p)| SkyPiece::band(PieceKind::Sky, k, p.band, lit(k + 1), compass));
+        let ground = tregenza::patches()
+            .into_iter()
+            .enumerate()
+            .map(|(k, b)| SkyPiece::band(PieceKind::Ground, k, b.mirrored(), lit(0), compass));
+        Ok(Sky {
+            kind: SkyKind::Uniform,
+            compass,
+            sun_local: DVec3::Z,
+            sun_position: None,
+            sun: None,
+            sun_below_horizon: false,
+            zenith_radiance: 1.0,
+            ratio: PI,
+            ground_radiance: 1.0,
+            pieces: sky.chain(ground).collect(),
+            coefficients: Some(*c),
+        })
+    }
+
+    /// A daylight-coefficient sky's subdivision MF ([`Sky::coefficients`]); `None` for others.
+    pub fn subdivision(&self) -> Option<u32> {
+        self.coefficients.map(|c| c.subdivision)
+    }
+
+    /// For a daylight-coefficient sky, the column of [`SkyMatrix`] (0 the ground, 1 + k sky
+    /// patch k) that the direction `dir_to_sky` (model coordinates, any length) looks into;
+    /// `None` for other skies. At or below the horizon (and for a zero direction): the ground.
+    pub fn coefficient_channel(&self, dir_to_sky: Vec3) -> Option<usize> {
+        let mf = self.subdivision()?;
+        let d = self
+            .compass
+            .to_local(dir_to_sky.as_dvec3().normalize_or_zero());
+        Some(reinhart::patch_of(mf, d).map_or(0, |k| k + 1))
     }
 
     /// Sky patches (in `tregenza.cal`'s order), then ground patches, then the sun if up.
@@ -196,6 +275,11 @@ impl Sky {
         let d = self
             .compass
             .to_local(dir_to_sky.as_dvec3().normalize_or_zero());
+        if let Some(only) = self.coefficients.and_then(|c| c.only) {
+            let column =
+                reinhart::patch_of(self.subdivision().unwrap_or(1), d).map_or(0, |k| k + 1);
+            return [if column == only { 1.0 } else { 0.0 }; 3];
+        }
         if d.z > 0.0 {
             [self.zenith_radiance * self.kind.relative(d, self.sun_local); 3]
         } else {

@@ -292,10 +292,9 @@ impl<'a, I: Intersector> Driver<'a, I> {
             return Err(SolveError::NoIntersector(method.name()));
         }
         let mut st = State::new(mesh, materials, cfg.stop_fraction);
-        let sky = match &cfg.sky {
-            Some(spec) => Some(Sky::new(spec).map_err(|e| SolveError::Sky(e.to_string()))?),
-            None => None,
-        };
+        let sky = cfg
+            .build_sky()
+            .map_err(|e| SolveError::Sky(e.to_string()))?;
         if sky.is_some() && !method.casts_rays() {
             return Err(SolveError::SkyNeedsRays(method.name()));
         }
@@ -406,6 +405,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
                     k: g.len(),
                     sky: g.channel(super::lights::SKY_CHANNEL),
                     sun: g.channel(super::lights::SUN_CHANNEL),
+                    patches: g.channel(super::lights::GROUND_CHANNEL),
                 });
             let done = sky_shots::shoot(
                 &mut self.st,

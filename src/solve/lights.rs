@@ -31,7 +31,7 @@ pub enum GroupBy {
     Connected,
 }
 
-pub use crate::light::{SKY_CHANNEL, SUN_CHANNEL};
+pub use crate::light::{sky_patch_channel, GROUND_CHANNEL, SKY_CHANNEL, SUN_CHANNEL};
 
 /// The light group of every patch.
 #[derive(Clone, Debug, PartialEq)]

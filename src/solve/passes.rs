@@ -46,7 +46,6 @@ use super::{
 use crate::intersect::Intersector;
 use crate::mesh::Mesh;
 use crate::scene::Material;
-use crate::sky::Sky;
 use std::time::Instant;
 
 /// What the error target did (`summary.json`: `error_target`).
@@ -547,7 +546,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
             energy_per_ray: pre.stats.energy_per_ray,
         };
         let mut sol = pre.clone();
-        let sky = cfg.sky.as_ref().and_then(|s| Sky::new(s).ok());
+        let sky = cfg.build_sky().ok().flatten();
         let inputs = final_gather::GatherInputs {
             mesh: self.at.mesh,
             materials: self.at.materials,

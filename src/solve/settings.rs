@@ -185,6 +185,11 @@ pub struct SolveSettings {
     /// Daylight: the sky, ground glow and sun that shoot at the model from outside
     /// ([`super::sky_shots`]); `None` for none.
     pub sky: Option<crate::sky::SkySpec>,
+    /// Daylight coefficients: shoot the unit sky of [`crate::sky::Sky::coefficients`] in
+    /// `sky`'s orientation instead of its own luminance (the annual run; not a flag of
+    /// `solve`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sky_coefficients: Option<crate::sky::CoefficientSky>,
     /// Rays per gathered patch at the default tolerance ([`SolveSettings::gather_rays_per_patch`]).
     pub gather_rays: usize,
     /// Stop once the light still unshot (or in flight) is below this fraction of the emitted
@@ -215,12 +220,25 @@ impl Default for SolveSettings {
             final_gather: DEFAULT_FINAL_GATHER,
             gather_rays: DEFAULT_GATHER_RAYS,
             sky: None,
+            sky_coefficients: None,
             stop_unshot: None,
         }
     }
 }
 
 impl SolveSettings {
+    /// The sky the solve shoots: the spec's, or with [`SolveSettings::sky_coefficients`] the
+    /// unit sky of daylight coefficients in the spec's orientation; `None` without a sky.
+    pub fn build_sky(&self) -> Result<Option<crate::sky::Sky>, Invalid> {
+        let Some(spec) = &self.sky else {
+            return Ok(None);
+        };
+        match self.sky_coefficients {
+            Some(c) => crate::sky::Sky::coefficients(spec, &c).map(Some),
+            None => crate::sky::Sky::new(spec).map(Some),
+        }
+    }
+
     /// The settings of `radiosity reference` (adaptive rays, 100× the rays of a default solve).
     pub fn reference(seed: u64) -> SolveSettings {
         SolveSettings {
@@ -280,6 +298,14 @@ impl SolveSettings {
     /// Every command that solves calls this, so each refuses what `solve` refuses, in the same
     /// words.
     pub fn check(&self) -> Result<(), Invalid> {
+        if let Some(c) = self.sky_coefficients {
+            crate::sky::reinhart::check_subdivision(c.subdivision)?;
+            if self.sky.is_none() {
+                return Invalid::err(
+                    "daylight coefficients need a sky's orientation (zenith and north)",
+                );
+            }
+        }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) {
             return Invalid::err(format!(
                 "--tolerance must be in (0, 1), got {}",

@@ -139,12 +139,28 @@ pub struct SkyShots {
     pub rays: u64,
 }
 
-/// The per-light channels (`--per-light`): how many, and the sky's and the sun's.
+/// The per-light channels (`--per-light`): how many, and the sky's and the sun's; for daylight
+/// coefficients ([`crate::sky::Sky::coefficients`]) the ground's, each sky patch k's following
+/// it at `patches + 1 + k`.
 #[derive(Clone, Copy, Debug)]
 pub struct Channels {
     pub k: usize,
     pub sky: Option<usize>,
     pub sun: Option<usize>,
+    pub patches: Option<usize>,
+}
+
+impl Channels {
+    /// The channel `piece`'s light goes to.
+    fn of(&self, piece: &SkyPiece) -> Option<usize> {
+        use crate::sky::PieceKind;
+        match (piece.kind, self.patches) {
+            (PieceKind::Sun, _) => self.sun,
+            (PieceKind::Ground, Some(first)) => Some(first),
+            (PieceKind::Sky, Some(first)) => Some(first + 1 + piece.index),
+            _ => self.sky,
+        }
+    }
 }
 
 /// Shoots every piece of `sky` into the books at energy per ray `c` (and into its channel).
@@ -166,12 +182,10 @@ pub(super) fn shoot<I: Intersector>(
         let grid = PolarGrid::for_samples(super::scalar(&phi) / c);
         let x = grid.len();
         let phi_ray = phi.map(|p| p / x as f64);
-        // The shot's flux per channel: all of it in the sky's or the sun's.
+        // The shot's flux per channel: all of it in the piece's own (the sky's, the sun's, or
+        // its patch's).
         let shot_ch: Vec<[f64; 3]> = channels.map_or_else(Vec::new, |ch| {
-            let own = match piece.kind {
-                crate::sky::PieceKind::Sun => ch.sun,
-                _ => ch.sky,
-            };
+            let own = ch.of(piece);
             (0..ch.k)
                 .map(|c| if Some(c) == own { phi } else { [0.0; 3] })
                 .collect()

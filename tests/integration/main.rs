@@ -6,6 +6,7 @@
 mod common;
 mod scene_builder;
 
+mod annual;
 mod bad_input;
 mod checkpoint;
 mod cli;

@@ -14,6 +14,7 @@
 //! compiles this whole command line as a module of its own, to walk clap's own argument list
 //! and to parse flags into the jobs without running them.
 
+mod annual;
 mod args;
 mod bench;
 mod compare;
@@ -66,6 +67,9 @@ pub(crate) struct Cli {
 pub(crate) enum Command {
     /// Solve a scene and write patches.csv, render.png and summary.json into --out.
     Solve(Box<solve::SolveArgs>),
+    /// A year of daylight at a sensor grid from one solve (daylight coefficients and a weather
+    /// file): hourly illuminance and the annual metrics into --out.
+    Annual(Box<annual::AnnualArgs>),
     /// Describe a scene: polygons, patches, axis-aligned share, materials, lights, bounds.
     Info(scene::InfoArgs),
     /// Cast the same rays through every intersector the scene supports and compare the hit
@@ -100,6 +104,7 @@ pub(crate) enum Command {
 fn run(cli: Cli) -> Result<(), radiosity::Error> {
     match cli.command {
         Command::Solve(a) => solve::run(*a),
+        Command::Annual(a) => annual::run(*a),
         Command::Info(a) => scene::info(a),
         Command::Generate(c) => scene::generate(c),
         Command::Render(a) => saved::render(a),

@@ -1,0 +1,325 @@
+//! `radiosity annual`: a year of daylight at the grid's sensors from one solve (docs/design.md
+//! §9, annual daylight). The stages, in order:
+//!
+//! 1. **weather**: the weather file read and each hour's sky made (Perez over the Reinhart
+//!    patches, the sun kept apart: [`crate::sky::SkyMatrix`]) before any model is read, so
+//!    a bad file costs nothing;
+//! 2. **load, mesh, intersect, sides** as `solve` does; the model's own lights are left dark
+//!    (daylight alone is studied);
+//! 3. **solve** under the unit sky of daylight coefficients ([`Sky::coefficients`]), one light
+//!    channel per sky patch and one for the ground; resumable as `solve` (`--checkpoint`,
+//!    `--resume`);
+//! 4. **coefficients** at the sensors ([`LightAt::sensor_coefficients`]);
+//! 5. **the year**: each hour the coefficients times its sky, the sun's reflected light
+//!    through the patch that holds it and its direct light by shadow rays
+//!    ([`crate::annual::hourly`]).
+
+use super::stages::{self, Clock};
+use super::{hooks, SolveJob};
+use crate::annual::hourly::{self, Coefficients, Year};
+use crate::error::Error;
+use crate::grid::{Placed, Sensor};
+use crate::light::coefficients::SensorCoefficients;
+use crate::light::{LightAt, Rgb};
+use crate::progress::Progress;
+use crate::sky::{Sampling, SkyMatrix, SkyOptions, SunMode};
+use crate::solve::lights::{self, LightGroups};
+use crate::weather::Weather;
+use glam::Vec3;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Rays per sky patch of each sensor's direct view by default (`--patch-rays`).
+pub const DEFAULT_PATCH_RAYS: usize = 32;
+
+/// What `radiosity annual` is asked: the solve's job (the model, its mesh and solver settings,
+/// the sky's orientation and ground reflectance, the grid, checkpoints), the weather file and
+/// the sky's subdivision.
+#[derive(Clone, Debug)]
+pub struct AnnualJob {
+    pub solve: SolveJob,
+    pub weather: PathBuf,
+    /// The Reinhart subdivision MF (1: Tregenza's 145 patches).
+    pub subdivision: u32,
+    /// Rays per sky patch of each sensor's direct view.
+    pub patch_rays: usize,
+}
+
+/// What the run computed, before anything is written.
+pub struct Annual {
+    pub weather: Weather,
+    pub placed: Placed,
+    pub coefficients: Coefficients,
+    pub year: Year,
+    /// The solve's counters and the stages' seconds (wall, CPU).
+    pub solve: crate::solve::Solution,
+    pub seconds: Vec<(&'static str, f64, f64)>,
+    pub rays: u64,
+}
+
+impl AnnualJob {
+    /// The solve job as the annual run solves it: the unit sky of daylight coefficients in the
+    /// job's orientation and the job's ground reflectance.
+    fn coefficient_job(&self) -> Result<SolveJob, Error> {
+        let mut job = self.solve.clone();
+        let spec = crate::sky::SkySpec {
+            zenith: job.zenith,
+            north: job.north,
+            ..job.settings.solve.sky.unwrap_or_default()
+        };
+        job.settings.solve.sky = Some(spec);
+        job.settings.solve.sky_coefficients = Some(crate::sky::CoefficientSky {
+            subdivision: self.subdivision,
+            only: None,
+        });
+        job.settings.per_light = None;
+        job.check()?;
+        if job.grid.is_none() {
+            return Err(Error::Invalid(
+                "annual: --grid is needed (HEIGHT,SPACING or POINTS.csv): the year is computed at its sensors".into(),
+            ));
+        }
+        if !job.settings.solve.method.casts_rays() {
+            return Err(Error::Invalid(
+                "annual needs a method that casts rays (adaptive-hybrid or adaptive-rays)".into(),
+            ));
+        }
+        if self.patch_rays == 0 {
+            return Err(Error::Invalid("--patch-rays must be at least 1".into()));
+        }
+        Ok(job)
+    }
+}
+
+/// The weather file's skies: one row per hour, ground first, the sun apart.
+fn skies(job: &AnnualJob, ground: f64) -> Result<(Weather, SkyMatrix), Error> {
+    let weather = Weather::read(&job.weather).map_err(|e| Error::Invalid(e.to_string()))?;
+    let hours = weather
+        .sky_hours()
+        .map_err(|e| Error::Invalid(format!("{}: {}", job.weather.display(), e.0)))?;
+    let options = SkyOptions {
+        subdivision: job.subdivision,
+        ground_reflectance: ground,
+        sun: SunMode::Separate,
+        sampling: Sampling::Centre,
+    };
+    let sky = SkyMatrix::build(&hours, options)
+        .map_err(|e| Error::Invalid(format!("{}: {}", job.weather.display(), e.0)))?;
+    Ok((weather, sky))
+}
+
+/// The channels of the coefficient sky: the ground's, then each sky patch's.
+fn coefficient_groups(subdivision: u32, patches: usize) -> LightGroups {
+    let sky = crate::sky::reinhart::sky_patch_count(subdivision);
+    let mut names = vec![lights::GROUND_CHANNEL.to_string()];
+    names.extend((0..sky).map(lights::sky_patch_channel));
+    LightGroups {
+        names,
+        of_patch: vec![u32::MAX; patches],
+    }
+}
+
+/// Runs the stages of the module notes; writes nothing.
+pub fn run(
+    job: &AnnualJob,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+) -> Result<Annual, Error> {
+    let solve_job = job.coefficient_job()?;
+    let mut seconds = Vec::new();
+    let clock = Clock::start();
+    let spec = solve_job.settings.solve.sky.unwrap_or_default();
+    let (weather, sky_matrix) = skies(job, spec.ground_reflectance)?;
+    log(&format!(
+        "weather: {} ({}), {} hours",
+        job.weather.display(),
+        weather.location.name,
+        weather.len()
+    ));
+    seconds.push(("weather", clock.seconds(), clock.cpu_seconds()));
+
+    let clock = Clock::start();
+    let mut scene = stages::load(&solve_job, progress, log)?;
+    darken(&mut scene, log);
+    let mut model = stages::mesh(&solve_job, scene, progress, log)?;
+    let isect = stages::intersect(&solve_job, &model, progress, log)?;
+    stages::sides(&solve_job, &mut model, isect.as_ref(), progress, log);
+    stages::lit_backs(&solve_job, &mut model, isect.as_ref(), progress, log)?;
+    seconds.push(("model", clock.seconds(), clock.cpu_seconds()));
+    let Some((isect_ref, _)) = isect.as_ref() else {
+        return Err(Error::Invalid(
+            "annual needs a method that casts rays".into(),
+        ));
+    };
+
+    let mut run_hooks = hooks::build(&solve_job, &model, log)?;
+    let groups = coefficient_groups(job.subdivision, model.mesh.patches.len());
+    log(&format!(
+        "daylight coefficients: {} channels (the ground and {} sky patches, MF {})",
+        groups.len(),
+        groups.len() - 1,
+        job.subdivision
+    ));
+    run_hooks.light_groups = Some(Arc::new(groups));
+    let clock = Clock::start();
+    let sol = stages::solve(
+        &solve_job,
+        &model,
+        isect.as_ref(),
+        &run_hooks,
+        progress,
+        log,
+    )?;
+    seconds.push(("solve", clock.seconds(), clock.cpu_seconds()));
+
+    let clock = Clock::start();
+    progress.phase("daylight coefficients at the sensors");
+    let sky = solve_job
+        .settings
+        .solve
+        .build_sky()?
+        .ok_or_else(|| Error::Invalid("annual: no sky".into()))?;
+    let frame = *sky.compass();
+    let spec_grid = solve_job.grid.as_ref().expect("checked by coefficient_job");
+    let placed = spec_grid
+        .place(&model.mesh, isect_ref, &frame, solve_job.grid_outdoor)
+        .map_err(|e| Error::Invalid(e.to_string()))?;
+    let at: Vec<(Vec3, Vec3)> = placed
+        .sensors
+        .iter()
+        .map(|s: &Sensor| (s.position, s.normal))
+        .collect();
+    let materials = &model.scene.materials;
+    let light = LightAt::for_coefficients(
+        &model.mesh,
+        materials,
+        isect_ref,
+        &sol.b,
+        &sol.channels,
+        &sky,
+    );
+    let seed = solve_job.settings.solve.seed;
+    let sc: Vec<SensorCoefficients> =
+        light.sensor_coefficients(&at, solve_job.grid_rays, job.patch_rays, seed);
+    let mut rays: u64 = sc.iter().map(|s| s.rays).sum();
+    let luma = crate::export::patches::LUMA;
+    let coefficients = Coefficients::new(job.subdivision, &sc, luma);
+    seconds.push(("coefficients", clock.seconds(), clock.cpu_seconds()));
+
+    let clock = Clock::start();
+    progress.phase("the year");
+    let suns = hourly::sun_hours(&sky_matrix, job.subdivision);
+    let luma_rgb = Rgb::from_array(luma);
+    let view = |h: usize| match sky_matrix.sun(h) {
+        Some(beam) => {
+            let dir = frame.to_world(beam.dir).as_vec3().normalize();
+            light.sun_view(&at, &[dir], luma_rgb)
+        }
+        None => Vec::new(),
+    };
+    let year = hourly::year(&coefficients, &sky_matrix, &suns, &view);
+    rays += (year.hours.iter())
+        .filter(|&&h| sky_matrix.sun(h).is_some())
+        .count() as u64
+        * at.len() as u64;
+    seconds.push(("year", clock.seconds(), clock.cpu_seconds()));
+    log(&format!(
+        "the year: {} daylit hours × {} sensors",
+        year.hours.len(),
+        year.sensors
+    ));
+    Ok(Annual {
+        weather,
+        placed,
+        coefficients,
+        year,
+        solve: sol,
+        seconds,
+        rays,
+    })
+}
+
+/// Leaves the model's own lights dark: annual daylight studies the sky and the sun alone.
+fn darken(scene: &mut crate::scene::Scene, log: &mut impl FnMut(&str)) {
+    let lit = scene.materials.iter().filter(|m| m.is_emitter()).count();
+    for m in &mut scene.materials {
+        m.ke = [0.0; 3];
+    }
+    let luminaires = scene.luminaires.len();
+    scene.luminaires.clear();
+    let sun = scene.sun.take().is_some();
+    if lit + luminaires > 0 || sun {
+        log(&format!(
+            "annual daylight: the model's own lights are left dark ({lit} emitting materials, {luminaires} luminaires{})",
+            if sun { ", its directional light" } else { "" }
+        ));
+    }
+}
+
+/// Writes a row-major `rows × cols` matrix of f32 as a NumPy `.npy` file.
+pub fn write_npy(path: &std::path::Path, rows: usize, cols: usize, v: &[f32]) -> Result<(), Error> {
+    use npyz::WriterBuilder;
+    crate::export::write_atomic(path, |w| {
+        let mut npy = npyz::WriteOptions::new()
+            .default_dtype()
+            .shape(&[rows as u64, cols as u64])
+            .writer(w)
+            .begin_nd()?;
+        npy.extend(v.iter().copied())?;
+        npy.finish()
+    })
+    .map_err(|e| Error::Invalid(e.to_string()))
+}
+
+/// Runs the year ([`run`]) and writes it into the job's folder: `annual/illuminance.npy` and
+/// `annual/direct_sun.npy` (float32, daylit hours × sensors, lux), `annual/hours.csv`
+/// (`row,hour_of_year,month,day,hour`: the weather file's hour of each row, its centre in
+/// local standard time). Returns the lines to print.
+pub fn run_and_write(
+    job: &AnnualJob,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+) -> Result<Vec<String>, Error> {
+    let a = run(job, progress, log)?;
+    let dir = job.solve.out.join("annual");
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| Error::Invalid(format!("{}: cannot create it ({e})", dir.display())))?;
+    let (rows, cols) = (a.year.hours.len(), a.year.sensors);
+    write_npy(
+        &dir.join("illuminance.npy"),
+        rows,
+        cols,
+        &a.year.illuminance,
+    )?;
+    write_npy(&dir.join("direct_sun.npy"), rows, cols, &a.year.direct_sun)?;
+    let mut hours = String::from("row,hour_of_year,month,day,hour\n");
+    for (row, &h) in a.year.hours.iter().enumerate() {
+        let w = &a.weather.hours[h];
+        hours += &format!("{row},{h},{},{},{}\n", w.month, w.day, w.hour);
+    }
+    let path = dir.join("hours.csv");
+    crate::export::write_atomic(&path, |w| w.write_all(hours.as_bytes()))
+        .map_err(|e| Error::Invalid(format!("{}: cannot write it ({e})", path.display())))?;
+    let mean: Vec<f64> = (0..cols)
+        .map(|s| {
+            let sum: f64 = (0..rows)
+                .map(|r| f64::from(a.year.illuminance[r * cols + s]))
+                .sum();
+            sum / rows.max(1) as f64
+        })
+        .collect();
+    let df = vec![0.0; cols];
+    let path = job.solve.out.join("grid.csv");
+    crate::grid::write_csv(&path, &a.placed.sensors, &mean, &df, &a.placed.zones)
+        .map_err(|e| Error::Invalid(format!("{}: cannot write it ({e})", path.display())))?;
+    let mut lines = vec![format!(
+        "annual: {} daylit hours × {} sensors into {}",
+        rows,
+        cols,
+        dir.display()
+    )];
+    for (stage, wall, cpu) in &a.seconds {
+        lines.push(format!("  {stage}: {wall:.1} s ({cpu:.1} s CPU)"));
+    }
+    Ok(lines)
+}
