@@ -178,3 +178,39 @@ fn finite(v: f64) -> f32 {
         0.0
     }
 }
+
+/// The CIE overcast sky (and its ground glow, reflectance `ground_reflectance`) as radiances
+/// per column (the ground, then each sky patch of `subdivision`) for an unobstructed horizontal
+/// illuminance of 1 W/m² from the sky: each patch's cos-weighted mean radiance, as the solver's
+/// own pieces ([`crate::sky::piece`]). The coefficients weighted by it are a sensor's daylight
+/// factor (× 100 %): what `solve --sky overcast` would give, with no solve of its own.
+pub fn overcast_columns(subdivision: u32, ground_reflectance: f64) -> Vec<f64> {
+    use crate::sky::SkyKind;
+    let patches = reinhart::patches(subdivision).unwrap_or_default();
+    let relative = |d: glam::DVec3| SkyKind::Overcast.relative(d, glam::DVec3::Z);
+    let q: Vec<f64> = patches.iter().map(|p| p.band.integrate(relative)).collect();
+    let total: f64 = q.iter().sum();
+    let mut out = vec![ground_reflectance / std::f64::consts::PI];
+    out.extend(
+        patches
+            .iter()
+            .zip(&q)
+            .map(|(p, qk)| qk / total / p.band.projected_solid_angle()),
+    );
+    out
+}
+
+/// Each sensor's daylight factor, %, under [`overcast_columns`] `sky`.
+pub fn daylight_factors(coef: &Coefficients, sky: &[f64]) -> Vec<f64> {
+    (0..coef.sensors())
+        .map(|s| {
+            let row = coef.row(&coef.total, s);
+            100.0
+                * row
+                    .iter()
+                    .zip(sky)
+                    .map(|(&d, &l)| f64::from(d) * l)
+                    .sum::<f64>()
+        })
+        .collect()
+}

@@ -288,3 +288,13 @@ fn one_coefficient_equals_a_plain_solve_under_its_patch_alone() {
         );
     }
 }
+
+#[test]
+fn the_year_is_the_same_on_any_thread_count() {
+    let dir = room_dir();
+    let j = job(dir.path(), "room.obj", 1);
+    let one = crate::common::on_threads(Some(1), || run(&j));
+    let two = crate::common::on_threads(Some(2), || run(&j));
+    assert_eq!(one.coefficients, two.coefficients);
+    assert_eq!(one.year, two.year);
+}
