@@ -3,7 +3,7 @@
 //!
 //! The solver gives, for each daylit hour of a weather file and each sensor, the total
 //! illuminance E and the illuminance of the direct sun alone E_sun (lux): two hours × sensors
-//! matrices, row-major, f32 ([`Series`]). This module turns them into figures; it
+//! matrices, row-major, f32 ([`Series`]). This module turns them into figures and files; it
 //! computes no light.
 //!
 //! - **When people are there** ([`schedule`]): the occupied hours, 8 AM to 6 PM local time by
@@ -15,6 +15,9 @@
 //!   alike, outdoor ones not counted).
 //! - **EN 17037** ([`en17037`]): the level of daylight provision reached (minimum, medium,
 //!   high) over the standard's daylight hours.
+//! - **Files** ([`files`]): the matrices as `.npy` (and CSV on request), `hours.csv` naming each
+//!   row's hour, the per-sensor metrics as CSV; **pictures** ([`plans`]): a plan of each metric
+//!   beside `grid.png`.
 //!
 //! # Conventions
 //!
@@ -31,13 +34,19 @@
 //!   value is below every threshold and counts as such.
 
 pub mod en17037;
+pub mod files;
 pub mod metrics;
+pub mod plans;
 pub mod schedule;
 
 pub use en17037::{daylight_hours, En17037, LevelResult, LEVELS};
+pub use files::{
+    write_hours_csv, write_matrix, write_sensors_csv, MatrixFormat, HOURS_HEADER, SENSORS_HEADER,
+};
 pub use metrics::{
     annual_metrics, indoor_weights, AnnualMetrics, AnnualSummary, SensorMetrics, Thresholds,
 };
+pub use plans::write_plans;
 pub use schedule::{Dst, Occupancy};
 
 use crate::settings::Invalid;
@@ -112,7 +121,7 @@ impl Period {
     }
 
     /// Whether the period holds 29 February (a leap-year file): its hours of the year then
-    /// count that day.
+    /// count that day ([`files::hour_of_year`]).
     pub fn is_leap(&self) -> bool {
         self.stamps.iter().any(|s| s.month == 2 && s.day == 29)
     }
