@@ -29,7 +29,9 @@
 //! [`photometry`] (luminaire files: IES LM-63 and EULUMDAT), [`luminaire`] (placed
 //! luminaires: position, aiming frame, intensity toward a direction, the `--luminaires`
 //! schedule), [`weather`] (weather files, EPW and Radiance's `.wea`: an hourly series of
-//! irradiance at a place, for annual daylight).
+//! irradiance at a place, for annual daylight), [`annual`] (annual daylight metrics from a
+//! year of hourly illuminance at the grid's sensors: DA, sDA, ASE, UDI, EN 17037; their files
+//! and plans).
 //! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 

@@ -38,7 +38,7 @@ pub mod work_plane;
 pub mod zones;
 
 pub use csv::{read_points, write_csv, CSV_HEADER};
-pub use plan::plan_image;
+pub use plan::{plan_image, plan_image_scaled, PlanScale};
 pub use stats::{stats, GridReport, GridStats, RoomStats, StoreyStats};
 pub use work_plane::{work_plane, MAX_COLUMNS, MIN_STOREY_CLEARANCE};
 pub use zones::{Outdoor, Zone};

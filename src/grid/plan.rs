@@ -2,7 +2,9 @@
 //! side by side at one scale, each sensor a cell coloured by its illuminance, north up.
 //!
 //! The colours are those of [`false_colour`]: viridis on a log scale fitted to the values (at
-//! most four decades, ends on 1–2–5 steps), with its legend in lux on the right. Each storey
+//! most four decades, ends on 1–2–5 steps), with its legend in lux on the right; or, for
+//! values that are not illuminances (the annual metrics' % of hours), on a fixed linear scale
+//! in their unit ([`PlanScale`]). Each storey
 //! ([`storeys`]) is labelled with the height of its lowest sensors ("+0.8 m": the plane's
 //! height, not the floor's). A lattice's cells tile the plan; points from a file are drawn as
 //! squares of their typical spacing. Where cells overlap (two floors of one storey in a
@@ -23,6 +25,53 @@ const MIN_HEIGHT: u32 = 200;
 /// Text, the north marker and the storey labels.
 const INK: [u8; 3] = [230, 230, 230];
 
+/// How a plan colours its values and labels its legend and panels.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PlanScale {
+    /// Illuminance: the log scale [`Scale::fit`] fits to the values, the legend in lux, each
+    /// panel's figures "Eav 540 lx U0 0.15 Emin/Emax 0.05" (the grid's plan, `grid.png`).
+    Lux,
+    /// A fixed linear scale from `lo` (the bottom colour) to `hi` (the top; values beyond
+    /// either end take its colour), ticks every `step` from `lo`, `unit` on top of the legend
+    /// and after each panel's mean: "+0.8 m  av 54 %" (the annual metrics' plans: % of
+    /// occupied hours, hours).
+    Linear {
+        lo: f64,
+        hi: f64,
+        step: f64,
+        unit: String,
+    },
+}
+
+impl PlanScale {
+    /// The colour of `v`.
+    fn colour(&self, log: &Scale, v: f64) -> [u8; 3] {
+        match self {
+            PlanScale::Lux => colour_at(log.t(v)),
+            PlanScale::Linear { lo, hi, .. } => colour_at((v - lo) / (hi - lo)),
+        }
+    }
+
+    /// Draws the legend in the panel from column `x0`.
+    fn draw_legend(&self, img: &mut image::RgbImage, x0: u32, log: &Scale) {
+        match self {
+            PlanScale::Lux => false_colour::draw_legend(img, x0, log, "lux"),
+            PlanScale::Linear { lo, hi, step, unit } => {
+                let n = if *step > 0.0 && hi > lo {
+                    ((hi - lo) / step + 1e-9).floor().min(100.0) as usize
+                } else {
+                    0
+                };
+                let ticks: Vec<(f64, String)> = (0..=n)
+                    .map(|k| lo + k as f64 * step)
+                    .map(|v| ((v - lo) / (hi - lo), false_colour::label(v)))
+                    .collect();
+                false_colour::draw_legend_ticks(img, x0, unit, &ticks);
+            }
+        }
+    }
+}
+
 /// The plan of `sensors` (with `lux`, one value per sensor) oriented by `compass`: panels `width`
 /// pixels wide in all (at least 64) and the legend ([`LEGEND_WIDTH`]) to their right; the height
 /// follows from the plan's shape. `spacing_hint` is the cell size in metres (the lattice's
@@ -37,7 +86,23 @@ pub fn plan_image(
     spacing_hint: f32,
     width: u32,
 ) -> image::RgbImage {
-    assert_eq!(sensors.len(), lux.len(), "one lux value per sensor");
+    plan_image_scaled(sensors, lux, compass, spacing_hint, width, &PlanScale::Lux)
+}
+
+/// [`plan_image`] of any values (one per sensor) on `scale`: the same picture for
+/// [`PlanScale::Lux`]; a value that is not finite is drawn as 0.
+///
+/// # Panics
+/// If `values` does not hold one value per sensor (a caller's bug).
+pub fn plan_image_scaled(
+    sensors: &[Sensor],
+    values: &[f64],
+    compass: &Compass,
+    spacing_hint: f32,
+    width: u32,
+    scale: &PlanScale,
+) -> image::RgbImage {
+    assert_eq!(sensors.len(), values.len(), "one value per sensor");
     let local: Vec<DVec3> = sensors
         .iter()
         .map(|s| compass.to_local(s.position.as_dvec3()))
@@ -45,8 +110,8 @@ pub fn plan_image(
     let storey = storeys(&local.iter().map(|p| p.z).collect::<Vec<_>>());
     let cell = cell_size(&local, &storey, spacing_hint);
     let layout = Layout::new(&local, &storey, cell, width.max(MIN_WIDTH));
-    let mut seen: Vec<f64> = lux.to_vec();
-    let scale = Scale::fit(&mut seen);
+    let mut seen: Vec<f64> = values.to_vec();
+    let log = Scale::fit(&mut seen);
     let mut img = image::RgbImage::from_pixel(
         layout.width + LEGEND_WIDTH,
         layout.height,
@@ -56,12 +121,12 @@ pub fn plan_image(
     let mut order: Vec<usize> = (0..sensors.len()).collect();
     order.sort_by(|&a, &b| local[a].z.total_cmp(&local[b].z));
     for k in order {
-        let colour = colour_at(scale.t(super::csv::finite(lux[k])));
+        let colour = scale.colour(&log, super::csv::finite(values[k]));
         fill(&mut img, layout.cell(local[k], storey[k]), colour);
     }
-    layout.draw_labels(&mut img, &local, &storey, lux);
+    layout.draw_labels(&mut img, &local, &storey, values, scale);
     draw_north(&mut img, layout.font, layout.top);
-    false_colour::draw_legend(&mut img, layout.width, &scale, "lux");
+    scale.draw_legend(&mut img, layout.width, &log);
     img
 }
 
@@ -159,28 +224,43 @@ impl Layout {
     }
 
     /// Each panel's label: the height of its lowest sensors, "+0.8 m", then, where the panel
-    /// is wide enough, its figures as a lighting designer reads them: "Eav 540 lx U0 0.15
-    /// Emin/Emax 0.05" (or the first two alone).
-    fn draw_labels(&self, img: &mut image::RgbImage, local: &[DVec3], storey: &[u32], lux: &[f64]) {
+    /// is wide enough, its figures: for lux as a lighting designer reads them, "Eav 540 lx U0
+    /// 0.15 Emin/Emax 0.05" (or the first two alone); on a linear scale the mean and the
+    /// unit, "av 54 %".
+    fn draw_labels(
+        &self,
+        img: &mut image::RgbImage,
+        local: &[DVec3],
+        storey: &[u32],
+        values: &[f64],
+        scale: &PlanScale,
+    ) {
         let n = self.panel_x.len();
         let mut lowest = vec![f64::INFINITY; n];
-        let mut values = vec![Vec::new(); n];
-        for ((p, &s), &e) in local.iter().zip(storey).zip(lux) {
+        let mut of_panel = vec![Vec::new(); n];
+        for ((p, &s), &e) in local.iter().zip(storey).zip(values) {
             lowest[s as usize] = lowest[s as usize].min(p.z);
-            values[s as usize].push(super::csv::finite(e));
+            of_panel[s as usize].push(super::csv::finite(e));
         }
-        for ((x, z), v) in self.panel_x.iter().zip(lowest).zip(&values) {
+        for ((x, z), v) in self.panel_x.iter().zip(lowest).zip(&of_panel) {
             if !z.is_finite() {
                 continue;
             }
             let s = super::stats::stats(v, &vec![0.0; v.len()]);
             let height = format!("{z:+.1} m");
-            let mean = format!("  Eav {:.0} lx  U0 {:.2}", s.mean_lux, s.uniformity);
-            let ratio = format!("  Emin/Emax {:.2}", s.min_over_max);
+            let figures = match scale {
+                PlanScale::Lux => [
+                    format!("  Eav {:.0} lx  U0 {:.2}", s.mean_lux, s.uniformity),
+                    format!("  Emin/Emax {:.2}", s.min_over_max),
+                ],
+                PlanScale::Linear { unit, .. } => {
+                    [format!("  av {:.0} {unit}", s.mean_lux), String::new()]
+                }
+            };
             let fits = |t: &str| (glyphs::width(t) * self.font) as i64 <= self.panel_w;
             let label = [
-                height.clone() + &mean + &ratio,
-                height.clone() + &mean,
+                height.clone() + &figures[0] + &figures[1],
+                height.clone() + &figures[0],
                 height,
             ]
             .into_iter()
@@ -300,6 +380,42 @@ mod tests {
         // Labels and the north marker are inked; a second call draws the same picture.
         assert!(img.pixels().filter(|p| p.0 == INK).count() > 50);
         assert_eq!(plan_image(&s, &lux, &compass, 0.5, 600), img);
+    }
+
+    #[test]
+    fn grid_plan_on_a_linear_scale_colours_by_the_scale_not_the_values() {
+        let (s, lux) = two_storeys();
+        let compass = Compass::default();
+        let scaled = |scale: &PlanScale| plan_image_scaled(&s, &lux, &compass, 0.5, 600, scale);
+        assert_eq!(
+            scaled(&PlanScale::Lux),
+            plan_image(&s, &lux, &compass, 0.5, 600)
+        );
+        let pct: Vec<f64> = (0..s.len())
+            .map(|k| (k % 10) as f64 * 100.0 / 9.0)
+            .collect();
+        let linear = PlanScale::Linear {
+            lo: 0.0,
+            hi: 200.0,
+            step: 50.0,
+            unit: "%".into(),
+        };
+        let img = plan_image_scaled(&s, &pct, &compass, 0.5, 600, &linear);
+        let local: Vec<DVec3> = s
+            .iter()
+            .map(|x| compass.to_local(x.position.as_dvec3()))
+            .collect();
+        let storey = storeys(&local.iter().map(|p| p.z).collect::<Vec<_>>());
+        let layout = Layout::new(&local, &storey, 0.5, 600);
+        for k in 0..s.len() {
+            let (x, y) = centre_pixel(&layout, local[k], storey[k]);
+            assert_eq!(
+                img.get_pixel(x, y).0,
+                colour_at(pct[k] / 200.0),
+                "sensor {k}"
+            );
+        }
+        assert_ne!(img, scaled(&PlanScale::Lux));
     }
 
     #[test]

@@ -188,6 +188,21 @@ pub fn render(
 /// The legend: a vertical colour bar, its 1–2–5 ticks labelled, and the unit on top, in a panel
 /// of [`LEGEND_WIDTH`] from column `x0` (the grid's plan draws it too, in lux).
 pub(crate) fn draw_legend(img: &mut image::RgbImage, x0: u32, scale: &Scale, unit: &str) {
+    let ticks: Vec<(f64, String)> = (scale.ticks().into_iter())
+        .map(|v| (scale.t(v), label(v)))
+        .collect();
+    draw_legend_ticks(img, x0, unit, &ticks);
+}
+
+/// A legend of any scale: the colour bar from 0 (bottom) to 1 (top), a tick at each
+/// (position along the bar in [0, 1], label) of `ticks`, and the unit on top, in a panel of
+/// [`LEGEND_WIDTH`] from column `x0`.
+pub(crate) fn draw_legend_ticks(
+    img: &mut image::RgbImage,
+    x0: u32,
+    unit: &str,
+    ticks: &[(f64, String)],
+) {
     let ht = img.height() as i64;
     let font = if ht >= 240 { 2 } else { 1 };
     let ink = [230, 230, 230];
@@ -208,14 +223,14 @@ pub(crate) fn draw_legend(img: &mut image::RgbImage, x0: u32, scale: &Scale, uni
             }
         }
     }
-    for v in scale.ticks() {
-        let y = bottom - (scale.t(v) * (bottom - top) as f64).round() as i64;
+    for (t, text) in ticks {
+        let y = bottom - (t * (bottom - top) as f64).round() as i64;
         for x in bx1..bx1 + 4 {
             if (x as u32) < img.width() {
                 img.put_pixel(x as u32, y as u32, image::Rgb(ink));
             }
         }
-        glyphs::draw(img, bx1 + 7, y - fh / 2, font, &label(v), ink);
+        glyphs::draw(img, bx1 + 7, y - fh / 2, font, text, ink);
     }
 }
 

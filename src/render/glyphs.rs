@@ -1,6 +1,6 @@
 //! A tiny built-in bitmap font for the labels of image legends: digits and the few letters
 //! numbers and their units need (`.`, `-`, `+`, `k`, `W`, `/`, `m`, `lux`, `N` for north, and
-//! `E`, `U`, `a`, `v`, `i`, `n` for the grid's figures),
+//! `E`, `U`, `a`, `v`, `i`, `n` for the grid's figures, `%` and `h` for the annual metrics),
 //! 5 pixels high. Enough to label a
 //! colour scale without a font file or a text-rendering crate.
 
@@ -36,6 +36,9 @@ fn glyph(c: char) -> Option<[&'static str; 5]> {
         'v' => ["...", "#.#", "#.#", "#.#", ".#."],
         'i' => ["#", ".", "#", "#", "#"],
         'n' => ["...", "##.", "#.#", "#.#", "#.#"],
+        // The annual metrics' plans (src/annual): "%" of occupied hours, "h" of sun.
+        '%' => ["##..#", "##.#.", "..#..", ".#.##", "#..##"],
+        'h' => ["#..", "#..", "##.", "#.#", "#.#"],
         ' ' => ["..", "..", "..", "..", ".."],
         _ => return None,
     })
@@ -89,7 +92,7 @@ mod tests {
 
     #[test]
     fn glyphs_are_rectangular() {
-        for c in "0123456789.-kW/m lux+N".chars() {
+        for c in "0123456789.-kW/m lux+NEUavin%h".chars() {
             let g = glyph(c).unwrap();
             assert!(g.iter().all(|r| r.len() == g[0].len()), "{c}");
         }
