@@ -43,6 +43,17 @@ pub enum Error {
     Plot(String),
 }
 
+/// Annual metrics: a non-finite illuminance is the solver's fault (exit 1); a bad setting or
+/// an unwritable file the user's.
+impl From<crate::annual::AnnualError> for Error {
+    fn from(e: crate::annual::AnnualError) -> Error {
+        match e {
+            crate::annual::AnnualError::NotFinite { .. } => Error::Failed(e.to_string()),
+            _ => Error::Invalid(e.to_string()),
+        }
+    }
+}
+
 impl Error {
     /// 2 for what the user can fix (input, flags, output folder), 1 for internal failures.
     pub fn exit_code(&self) -> u8 {

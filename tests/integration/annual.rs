@@ -113,6 +113,9 @@ fn job(dir: &Path, model: &str, subdivision: u32) -> AnnualJob {
         weather: dir.join("t.wea"),
         subdivision,
         patch_rays: annual::DEFAULT_PATCH_RAYS,
+        occupancy: Default::default(),
+        thresholds: Default::default(),
+        csv: false,
     }
 }
 

@@ -1,10 +1,11 @@
 //! `radiosity annual`.
 
-use super::args::{parse_vec3, source, SceneArgs, SolverArgs, Xyz};
+use super::args::{parse_floats, parse_vec3, source, SceneArgs, SolverArgs, Xyz};
 use super::interrupt_flag;
 use crate::outln;
 use clap::Args;
 use glam::Vec3;
+use radiosity::annual::{Dst, Occupancy, Thresholds};
 use radiosity::pipeline::annual::{self, AnnualJob, DEFAULT_PATCH_RAYS};
 use radiosity::pipeline::{RunSettings, SolveJob, DEFAULT_CHECKPOINT_EVERY};
 use radiosity::progress::Progress;
@@ -36,6 +37,21 @@ pub struct AnnualArgs {
     /// 2,305 (one light channel each: memory grows with it).
     #[arg(long, default_value_t = 1, value_name = "MF")]
     subdivision: u32,
+    /// The occupied hours START,END on the clock, hours: an hour counts when its centre is in
+    /// [START, END) (IES LM-83-12: 8,18, 3,650 hours a year).
+    #[arg(long, value_name = "START,END", value_parser = parse_window, default_value = "8,18")]
+    occupied: (f64, f64),
+    /// Daylight saving: none (LM-83-12 counts local standard time), us (second Sunday of March
+    /// to first Sunday of November) or eu (last Sunday of March to last Sunday of October):
+    /// the occupied window then starts an hour earlier in standard time.
+    #[arg(long, value_enum, default_value_t = Dst::None)]
+    dst: Dst,
+    /// Count Mondays to Fridays only (no holidays).
+    #[arg(long)]
+    weekdays_only: bool,
+    /// Also write the hourly matrices as CSV (illuminance.csv, direct_sun.csv) beside the .npy.
+    #[arg(long)]
+    csv: bool,
     /// Reflectance of the ground outside the model, which glows below the horizon.
     #[arg(long, default_value_t = DEFAULT_GROUND_REFLECTANCE, value_name = "RHO", allow_negative_numbers = true)]
     ground_reflectance: f64,
@@ -108,6 +124,15 @@ impl AnnualArgs {
             weather: self.weather.clone(),
             subdivision: self.subdivision,
             patch_rays: self.patch_rays,
+            occupancy: Occupancy {
+                start: self.occupied.0,
+                end: self.occupied.1,
+                dst: self.dst,
+                weekdays_only: self.weekdays_only,
+                ..Occupancy::default()
+            },
+            thresholds: Thresholds::default(),
+            csv: self.csv,
         })
     }
 }
@@ -128,4 +153,8 @@ pub fn run(a: AnnualArgs) -> Result<(), radiosity::Error> {
         }
     }
     Ok(())
+}
+
+fn parse_window(s: &str) -> Result<(f64, f64), String> {
+    parse_floats::<2>(s).map(|[a, b]| (a, b))
 }

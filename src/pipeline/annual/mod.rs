@@ -46,10 +46,20 @@ pub struct AnnualJob {
     pub subdivision: u32,
     /// Rays per sky patch of each sensor's direct view.
     pub patch_rays: usize,
+    /// When the metrics count hours (`--occupied`, `--dst`, `--weekdays-only`).
+    pub occupancy: crate::annual::Occupancy,
+    pub thresholds: crate::annual::Thresholds,
+    /// Also write the hourly matrices as CSV (`--csv`).
+    pub csv: bool,
 }
 
 /// What the run computed, before anything is written.
 pub struct Annual {
+    /// The model's name and patch count.
+    pub scene: String,
+    pub patches: usize,
+    /// The model's orientation.
+    pub frame: crate::sky::Compass,
     pub weather: Weather,
     pub placed: Placed,
     pub coefficients: Coefficients,
@@ -87,6 +97,8 @@ impl AnnualJob {
                 "annual needs a method that casts rays (adaptive-hybrid or adaptive-rays)".into(),
             ));
         }
+        self.occupancy.validate()?;
+        self.thresholds.validate()?;
         if self.patch_rays == 0 {
             return Err(Error::Invalid("--patch-rays must be at least 1".into()));
         }
@@ -232,6 +244,9 @@ pub fn run(
         year.sensors
     ));
     Ok(Annual {
+        scene: model.scene.name.clone(),
+        patches: model.mesh.patches.len(),
+        frame,
         weather,
         placed,
         coefficients,
