@@ -116,6 +116,8 @@ fn job(dir: &Path, model: &str, subdivision: u32) -> AnnualJob {
         occupancy: Default::default(),
         thresholds: Default::default(),
         csv: false,
+        coefficients: None,
+        rotate: 0.0,
     }
 }
 
@@ -300,4 +302,63 @@ fn the_year_is_the_same_on_any_thread_count() {
     let two = crate::common::on_threads(Some(2), || run(&j));
     assert_eq!(one.coefficients, two.coefficients);
     assert_eq!(one.year, two.year);
+}
+
+#[test]
+fn coefficients_read_back_give_the_same_year_and_a_turned_model_its_own() {
+    let dir = room_dir();
+    let first = job(dir.path(), "room.obj", 1);
+    annual::run_and_write(&first, &Progress::hidden(), &mut |_| {}).unwrap();
+    let read = |d: &Path| std::fs::read(d.join("annual/illuminance.npy")).unwrap();
+    // The same weather from the coefficients: the same bytes, no solve.
+    let again = AnnualJob {
+        coefficients: Some(dir.path().join("out")),
+        solve: SolveJob {
+            out: dir.path().join("again"),
+            ..first.solve.clone()
+        },
+        ..first.clone()
+    };
+    let a = annual::run(&again, &Progress::hidden(), &mut |_| {}).unwrap();
+    assert!(a.solve.is_none(), "no solve with --coefficients");
+    annual::run_and_write(&again, &Progress::hidden(), &mut |_| {}).unwrap();
+    assert_eq!(
+        read(&dir.path().join("out")),
+        read(&dir.path().join("again"))
+    );
+    // Turned 90° clockwise (the window then faces west) from the coefficients, against a
+    // solve whose north is where true north then lies in the model (−X).
+    let turned = AnnualJob {
+        rotate: 90.0,
+        ..again.clone()
+    };
+    let mut west = first.clone();
+    west.solve.north = glam::Vec3::NEG_X;
+    west.solve.settings.solve.sky = Some(SkySpec {
+        north: glam::Vec3::NEG_X,
+        ..SkySpec::default()
+    });
+    let (t, w) = (run(&turned), run(&west));
+    assert_eq!(t.year.hours, w.year.hours);
+    let (tl, wl): (Vec<f64>, Vec<f64>) = (
+        t.year.illuminance.iter().map(|&v| f64::from(v)).collect(),
+        w.year.illuminance.iter().map(|&v| f64::from(v)).collect(),
+    );
+    let err = relative(&tl, &wl);
+    eprintln!("turned 90°: {:.2} %", 100.0 * err);
+    assert!(
+        err < 0.03,
+        "turned from the coefficients against solved turned: {:.2} %",
+        100.0 * err
+    );
+    let unturned: f64 = run(&again)
+        .year
+        .illuminance
+        .iter()
+        .map(|&v| f64::from(v))
+        .sum();
+    assert!(
+        (unturned - tl.iter().sum::<f64>()).abs() > 0.05 * unturned,
+        "turning changes the year"
+    );
 }

@@ -49,6 +49,20 @@ pub struct AnnualArgs {
     /// Count Mondays to Fridays only (no holidays).
     #[arg(long)]
     weekdays_only: bool,
+    /// Use the daylight coefficients of an earlier `annual` run (its --out folder) instead of
+    /// solving: another weather file, --rotate or other occupied hours at the cost of the
+    /// product and the direct sun's shadow rays. The model and its mesh flags must be the run's.
+    #[arg(long, value_name = "DIR")]
+    coefficients: Option<PathBuf>,
+    /// Turn the model DEG degrees clockwise seen from above (its north then points DEG east of
+    /// --north): another orientation without solving again (with --coefficients).
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    rotate: f64,
     /// Also write the hourly matrices as CSV (illuminance.csv, direct_sun.csv) beside the .npy.
     #[arg(long)]
     csv: bool,
@@ -133,6 +147,8 @@ impl AnnualArgs {
             },
             thresholds: Thresholds::default(),
             csv: self.csv,
+            coefficients: self.coefficients.clone(),
+            rotate: self.rotate,
         })
     }
 }

@@ -18,9 +18,10 @@ use super::stages::{self, Clock};
 use super::{hooks, SolveJob};
 
 mod outputs;
+mod reuse;
 use crate::annual::hourly::{self, Coefficients, Year};
 use crate::error::Error;
-use crate::grid::{Placed, Sensor};
+use crate::grid::Sensor;
 use crate::light::coefficients::SensorCoefficients;
 use crate::light::{LightAt, Rgb};
 use crate::progress::Progress;
@@ -51,6 +52,11 @@ pub struct AnnualJob {
     pub thresholds: crate::annual::Thresholds,
     /// Also write the hourly matrices as CSV (`--csv`).
     pub csv: bool,
+    /// The folder of an earlier run whose coefficients to use instead of solving
+    /// (`--coefficients`).
+    pub coefficients: Option<PathBuf>,
+    /// Turn the model this many degrees clockwise seen from above (`--rotate`).
+    pub rotate: f64,
 }
 
 /// What the run computed, before anything is written.
@@ -60,13 +66,19 @@ pub struct Annual {
     pub patches: usize,
     /// The model's orientation.
     pub frame: crate::sky::Compass,
+    /// The hash of the model and its mesh settings (`--coefficients` checks it).
+    pub scene_hash: u64,
     pub weather: Weather,
-    pub placed: Placed,
+    /// The sensors, their zones and their coefficients.
+    pub sensors: Vec<Sensor>,
+    pub zones: Vec<crate::grid::Zone>,
     pub coefficients: Coefficients,
     pub year: Year,
-    /// The solve's counters and the stages' seconds (wall, CPU).
-    pub solve: crate::solve::Solution,
+    /// The solve's counters (`None` with `--coefficients`).
+    pub solve: Option<crate::solve::SolveStats>,
+    /// The stages' seconds (wall, CPU).
     pub seconds: Vec<(&'static str, f64, f64)>,
+    /// Rays cast: the solve, the sensors' coefficients, the direct sun.
     pub rays: u64,
 }
 
@@ -99,6 +111,12 @@ impl AnnualJob {
         }
         self.occupancy.validate()?;
         self.thresholds.validate()?;
+        if !self.rotate.is_finite() {
+            return Err(Error::Invalid(format!(
+                "--rotate: {} is not a number of degrees",
+                self.rotate
+            )));
+        }
         if self.patch_rays == 0 {
             return Err(Error::Invalid("--patch-rays must be at least 1".into()));
         }
@@ -109,9 +127,10 @@ impl AnnualJob {
 /// The weather file's skies: one row per hour, ground first, the sun apart.
 fn skies(job: &AnnualJob, ground: f64) -> Result<(Weather, SkyMatrix), Error> {
     let weather = Weather::read(&job.weather).map_err(|e| Error::Invalid(e.to_string()))?;
-    let hours = weather
+    let mut hours = weather
         .sky_hours()
         .map_err(|e| Error::Invalid(format!("{}: {}", job.weather.display(), e.0)))?;
+    reuse::rotate(&mut hours, job.rotate);
     let options = SkyOptions {
         subdivision: job.subdivision,
         ground_reflectance: ground,
@@ -167,73 +186,60 @@ pub fn run(
         ));
     };
 
-    let mut run_hooks = hooks::build(&solve_job, &model, log)?;
-    let groups = coefficient_groups(job.subdivision, model.mesh.patches.len());
-    log(&format!(
-        "daylight coefficients: {} channels (the ground and {} sky patches, MF {})",
-        groups.len(),
-        groups.len() - 1,
-        job.subdivision
-    ));
-    run_hooks.light_groups = Some(Arc::new(groups));
-    let clock = Clock::start();
-    let sol = stages::solve(
-        &solve_job,
-        &model,
-        isect.as_ref(),
-        &run_hooks,
-        progress,
-        log,
-    )?;
-    seconds.push(("solve", clock.seconds(), clock.cpu_seconds()));
-
-    let clock = Clock::start();
-    progress.phase("daylight coefficients at the sensors");
     let sky = solve_job
         .settings
         .solve
         .build_sky()?
         .ok_or_else(|| Error::Invalid("annual: no sky".into()))?;
     let frame = *sky.compass();
-    let spec_grid = solve_job.grid.as_ref().expect("checked by coefficient_job");
-    let placed = spec_grid
-        .place(&model.mesh, isect_ref, &frame, solve_job.grid_outdoor)
-        .map_err(|e| Error::Invalid(e.to_string()))?;
-    let at: Vec<(Vec3, Vec3)> = placed
-        .sensors
-        .iter()
-        .map(|s: &Sensor| (s.position, s.normal))
-        .collect();
-    let materials = &model.scene.materials;
-    let light = LightAt::for_coefficients(
-        &model.mesh,
-        materials,
-        isect_ref,
-        &sol.b,
-        &sol.channels,
-        &sky,
+    let hash = crate::export::solution::scene_hash(
+        &model.scene,
+        model.mesh.patch_size,
+        solve_job.settings.mesh.two_sided,
     );
-    let seed = solve_job.settings.solve.seed;
-    let sc: Vec<SensorCoefficients> =
-        light.sensor_coefficients(&at, solve_job.grid_rays, job.patch_rays, seed);
-    let mut rays: u64 = sc.iter().map(|s| s.rays).sum();
-    let luma = crate::export::patches::LUMA;
-    let coefficients = Coefficients::new(job.subdivision, &sc, luma);
-    seconds.push(("coefficients", clock.seconds(), clock.cpu_seconds()));
-
+    let zero = vec![[0.0; 3]; model.mesh.patches.len()];
+    let materials = &model.scene.materials;
+    let (found, stats) = match &job.coefficients {
+        Some(dir) => {
+            let r = reuse::read(dir, hash, job.subdivision)?;
+            log(&format!(
+                "coefficients of {} sensors read from {} (no solve)",
+                r.sensors.len(),
+                dir.display()
+            ));
+            (r, None)
+        }
+        None => {
+            let (r, stats) = solve_for(
+                &solve_job,
+                job,
+                &model,
+                isect.as_ref(),
+                &sky,
+                progress,
+                log,
+                &mut seconds,
+            )?;
+            (r, Some(stats))
+        }
+    };
     let clock = Clock::start();
     progress.phase("the year");
+    let at: Vec<(Vec3, Vec3)> = (found.sensors.iter())
+        .map(|s: &Sensor| (s.position, s.normal))
+        .collect();
+    let light = LightAt::new(&model.mesh, materials, isect_ref, &zero, Some(&sky), None);
     let suns = hourly::sun_hours(&sky_matrix, job.subdivision);
-    let luma_rgb = Rgb::from_array(luma);
+    let luma = Rgb::from_array(crate::export::patches::LUMA);
     let view = |h: usize| match sky_matrix.sun(h) {
         Some(beam) => {
             let dir = frame.to_world(beam.dir).as_vec3().normalize();
-            light.sun_view(&at, &[dir], luma_rgb)
+            light.sun_view(&at, &[dir], luma)
         }
         None => Vec::new(),
     };
-    let year = hourly::year(&coefficients, &sky_matrix, &suns, &view);
-    rays += (year.hours.iter())
+    let year = hourly::year(&found.coefficients, &sky_matrix, &suns, &view);
+    let sun_rays = (year.hours.iter())
         .filter(|&&h| sky_matrix.sun(h).is_some())
         .count() as u64
         * at.len() as u64;
@@ -245,16 +251,93 @@ pub fn run(
     ));
     Ok(Annual {
         scene: model.scene.name.clone(),
+        scene_hash: hash,
         patches: model.mesh.patches.len(),
         frame,
         weather,
-        placed,
-        coefficients,
+        sensors: found.sensors,
+        zones: found.zones,
+        coefficients: found.coefficients,
         year,
-        solve: sol,
+        rays: stats.as_ref().map_or(0, |s: &Solved| s.rays) + sun_rays,
+        solve: stats.map(|s| s.stats),
         seconds,
-        rays,
     })
+}
+
+/// What solving for the coefficients gave besides them: the solve's counters and the rays of
+/// the solve and the sensors.
+struct Solved {
+    stats: crate::solve::SolveStats,
+    rays: u64,
+}
+
+/// The solve under the coefficient sky and the sensors' coefficients (stages 3 and 4).
+#[allow(clippy::too_many_arguments)] // the stage's inputs, each a different thing; used once
+fn solve_for(
+    solve_job: &SolveJob,
+    job: &AnnualJob,
+    model: &crate::model::Model,
+    isect: Option<&(
+        crate::intersect::select::AnyIntersector,
+        crate::intersect::select::Selection,
+    )>,
+    sky: &crate::sky::Sky,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+    seconds: &mut Vec<(&'static str, f64, f64)>,
+) -> Result<(reuse::Reused, Solved), Error> {
+    let mut run_hooks = hooks::build(solve_job, model, log)?;
+    let groups = coefficient_groups(job.subdivision, model.mesh.patches.len());
+    log(&format!(
+        "daylight coefficients: {} channels (the ground and {} sky patches, MF {})",
+        groups.len(),
+        groups.len() - 1,
+        job.subdivision
+    ));
+    run_hooks.light_groups = Some(Arc::new(groups));
+    let clock = Clock::start();
+    let sol = stages::solve(solve_job, model, isect, &run_hooks, progress, log)?;
+    seconds.push(("solve", clock.seconds(), clock.cpu_seconds()));
+
+    let clock = Clock::start();
+    progress.phase("daylight coefficients at the sensors");
+    let Some((isect, _)) = isect else {
+        return Err(Error::Invalid(
+            "annual needs a method that casts rays".into(),
+        ));
+    };
+    let spec_grid = solve_job.grid.as_ref().expect("checked by coefficient_job");
+    let placed = spec_grid
+        .place(&model.mesh, isect, sky.compass(), solve_job.grid_outdoor)
+        .map_err(|e| Error::Invalid(e.to_string()))?;
+    if let Some(w) = &placed.warning {
+        log(&format!("warning: {w}"));
+    }
+    let at: Vec<(Vec3, Vec3)> = (placed.sensors.iter())
+        .map(|s: &Sensor| (s.position, s.normal))
+        .collect();
+    let materials = &model.scene.materials;
+    let light =
+        LightAt::for_coefficients(&model.mesh, materials, isect, &sol.b, &sol.channels, sky);
+    let seed = solve_job.settings.solve.seed;
+    let sc: Vec<SensorCoefficients> =
+        light.sensor_coefficients(&at, solve_job.grid_rays, job.patch_rays, seed);
+    let rays = sol.stats.rays + sc.iter().map(|s| s.rays).sum::<u64>();
+    let coefficients = Coefficients::new(job.subdivision, &sc, crate::export::patches::LUMA);
+    seconds.push(("coefficients", clock.seconds(), clock.cpu_seconds()));
+    let found = reuse::Reused {
+        coefficients,
+        sensors: placed.sensors,
+        zones: placed.zones,
+    };
+    Ok((
+        found,
+        Solved {
+            stats: sol.stats,
+            rays,
+        },
+    ))
 }
 
 /// Leaves the model's own lights dark: annual daylight studies the sky and the sun alone.

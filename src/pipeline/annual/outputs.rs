@@ -32,7 +32,7 @@ pub fn run_and_write(
         lux: &a.year.illuminance,
         sun_lux: &a.year.direct_sun,
     };
-    let weights = annual::indoor_weights(&a.placed.zones);
+    let weights = annual::indoor_weights(&a.zones);
     let metrics = annual::annual_metrics(&series, &weights, &job.occupancy, &job.thresholds)?;
     write_files(job, &a, &period, &metrics)?;
     a.seconds
@@ -79,16 +79,16 @@ fn write_files(
         MatrixFormat::Npy,
     )?;
     annual::write_hours_csv(&dir.join("hours.csv"), period, &a.year.hours)?;
-    let sensors = &a.placed.sensors;
+    let sensors = &a.sensors;
     annual::write_sensors_csv(
         &dir.join("sensors.csv"),
         sensors,
-        &a.placed.zones,
+        &a.zones,
         &metrics.sensors,
     )?;
     let mean = mean_occupied(a, period, job);
     let df = daylight_factors(job, a);
-    grid::write_csv(&out.join("grid.csv"), sensors, &mean, &df, &a.placed.zones).map_err(|e| {
+    grid::write_csv(&out.join("grid.csv"), sensors, &mean, &df, &a.zones).map_err(|e| {
         Error::Invalid(format!(
             "{}: cannot write it ({e})",
             out.join("grid.csv").display()
@@ -173,6 +173,9 @@ fn summary(job: &AnnualJob, a: &Annual, metrics: &AnnualMetrics) -> serde_json::
         },
         "coefficients": {
             "subdivision": c.subdivision,
+            "scene_hash": format!("{:016x}", a.scene_hash),
+            "from": job.coefficients.as_ref().map(|p| p.display().to_string()),
+            "rotate_degrees": job.rotate,
             "columns": c.columns,
             "sensors": c.sensors(),
             "patch_rays": job.patch_rays,
@@ -180,7 +183,7 @@ fn summary(job: &AnnualJob, a: &Annual, metrics: &AnnualMetrics) -> serde_json::
             "solver_channel_mib": (48 * channels * a.patches as u64) as f64 / 1048576.0,
             "sensor_coefficients_mib": (8 * channels * c.sensors() as u64) as f64 / 1048576.0,
         },
-        "solve": a.solve.stats,
+        "solve": a.solve,
         "rays": a.rays,
         "metrics": metrics.summary,
         "seconds": seconds,
