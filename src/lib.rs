@@ -29,9 +29,10 @@
 //! [`photometry`] (luminaire files: IES LM-63 and EULUMDAT), [`luminaire`] (placed
 //! luminaires: position, aiming frame, intensity toward a direction, the `--luminaires`
 //! schedule), [`weather`] (weather files, EPW and Radiance's `.wea`: an hourly series of
-//! irradiance at a place, for annual daylight), [`annual`] (annual daylight metrics from a
-//! year of hourly illuminance at the grid's sensors: DA, sDA, ASE, UDI, EN 17037; their files
-//! and plans).
+//! irradiance at a place, for annual daylight), [`annual`] (a year of daylight at the grid's sensors:
+//! the hourly product of the sensors' daylight coefficients and the weather's skies, and its
+//! metrics DA, sDA, ASE, UDI, EN 17037, their files and plans; `radiosity annual` runs it
+//! through [`pipeline`]).
 //! The `radiosity` binary (`src/bin/radiosity/`) only parses flags and prints.
 #![deny(unsafe_code)]
 
