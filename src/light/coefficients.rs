@@ -13,7 +13,7 @@
 //!   hemisphere rays binned to patches, so every patch the sensor sees gets its own rays and a
 //!   sun binned into a patch (the annual run's interreflected sun) finds a coefficient as
 //!   well-sampled as the rest;
-//! - **reflected**: the sensor's gather ([`Kernel::gather_at`]) over the solution, per channel,
+//! - **reflected**: the sensor's gather (`Kernel::gather_at`) over the solution, per channel,
 //!   its own rays that leave the model left out (the direct part counts them).
 
 use super::gather::{latin, Ask, Spot};

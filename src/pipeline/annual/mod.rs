@@ -6,7 +6,7 @@
 //!    a bad file costs nothing;
 //! 2. **load, mesh, intersect, sides** as `solve` does; the model's own lights are left dark
 //!    (daylight alone is studied);
-//! 3. **solve** under the unit sky of daylight coefficients ([`Sky::coefficients`]), one light
+//! 3. **solve** under the unit sky of daylight coefficients ([`crate::sky::Sky::coefficients`]), one light
 //!    channel per sky patch and one for the ground; resumable as `solve` (`--checkpoint`,
 //!    `--resume`);
 //! 4. **coefficients** at the sensors ([`LightAt::sensor_coefficients`]);
