@@ -41,6 +41,10 @@ pub enum Error {
     /// A plot could not be drawn (`radiosity compare`): exit code 1.
     #[error("cannot draw a plot: {0}")]
     Plot(String),
+    /// Ctrl-C stopped a run whose outputs would mislead if written from the part done
+    /// (`radiosity annual`): exit code 130, as a shell reports SIGINT.
+    #[error("{0}")]
+    Interrupted(String),
 }
 
 /// Annual metrics: a non-finite illuminance is the solver's fault (exit 1); a bad setting or
@@ -55,10 +59,12 @@ impl From<crate::annual::AnnualError> for Error {
 }
 
 impl Error {
-    /// 2 for what the user can fix (input, flags, output folder), 1 for internal failures.
+    /// 2 for what the user can fix (input, flags, output folder), 1 for internal failures,
+    /// 130 for Ctrl-C.
     pub fn exit_code(&self) -> u8 {
         match self {
             Error::Embree(_) | Error::Failed(_) | Error::Plot(_) => 1,
+            Error::Interrupted(_) => 130,
             _ => 2,
         }
     }

@@ -299,6 +299,14 @@ fn solve_for(
     let clock = Clock::start();
     let sol = stages::solve(solve_job, model, isect, &run_hooks, progress, log)?;
     seconds.push(("solve", clock.seconds(), clock.cpu_seconds()));
+    if sol.stats.stop_reason == Some(crate::solve::StopReason::Interrupted) {
+        let resume = (solve_job.checkpoint.as_ref())
+            .map(|p| format!("; continue with --resume {}", p.display()))
+            .unwrap_or_default();
+        return Err(Error::Interrupted(format!(
+            "interrupted: nothing written (a year from a part-solved sky would mislead){resume}"
+        )));
+    }
 
     let clock = Clock::start();
     progress.phase("daylight coefficients at the sensors");
