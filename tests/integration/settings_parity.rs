@@ -23,10 +23,11 @@ use std::collections::BTreeSet;
 /// Bad settings, each with the commands that take its flags besides `solve` (checked against
 /// clap's list: a command that gains the flag must be added here, and refuse it alike).
 const BAD: &[(&[&str], &[&str])] = &[
-    (&["--grid-outdoor", "maybe"], &[]),
+    (&["--grid-outdoor", "maybe"], &["annual"]),
     (
         &["--tolerance", "5"],
         &[
+            "annual",
             "sweep",
             "bench-shots",
             "bench-rays",
@@ -38,6 +39,7 @@ const BAD: &[(&[&str], &[&str])] = &[
     (
         &["--tolerance", "0"],
         &[
+            "annual",
             "sweep",
             "bench-shots",
             "bench-rays",
@@ -49,6 +51,7 @@ const BAD: &[(&[&str], &[&str])] = &[
     (
         &["--stop", "-1"],
         &[
+            "annual",
             "sweep",
             "bench-shots",
             "bench-rays",
@@ -60,6 +63,7 @@ const BAD: &[(&[&str], &[&str])] = &[
     (
         &["--energy-per-ray", "-2"],
         &[
+            "annual",
             "sweep",
             "bench-shots",
             "bench-rays",
@@ -71,6 +75,7 @@ const BAD: &[(&[&str], &[&str])] = &[
     (
         &["--hemicube-n", "1"],
         &[
+            "annual",
             "sweep",
             "bench-shots",
             "bench-rays",
@@ -82,6 +87,7 @@ const BAD: &[(&[&str], &[&str])] = &[
     (
         &["--gather-rays", "1"],
         &[
+            "annual",
             "sweep",
             "bench-shots",
             "bench-rays",
@@ -92,23 +98,48 @@ const BAD: &[(&[&str], &[&str])] = &[
     ),
     (
         &["--max-time", "0"],
-        &["sweep", "bench-shots", "bench-rays", "bench-elements"],
+        &[
+            "annual",
+            "sweep",
+            "bench-shots",
+            "bench-rays",
+            "bench-elements",
+        ],
     ),
     (
         &["--max-rays", "0"],
-        &["sweep", "bench-shots", "bench-rays", "bench-elements"],
+        &[
+            "annual",
+            "sweep",
+            "bench-shots",
+            "bench-rays",
+            "bench-elements",
+        ],
     ),
     (
         &["--error", "2"],
-        &["sweep", "bench-shots", "bench-rays", "bench-elements"],
+        &[
+            "annual",
+            "sweep",
+            "bench-shots",
+            "bench-rays",
+            "bench-elements",
+        ],
     ),
     (
         &["--method", "adaptive-rays", "--switch-at", "3"],
-        &["sweep", "bench-shots", "bench-rays", "bench-elements"],
+        &[
+            "annual",
+            "sweep",
+            "bench-shots",
+            "bench-rays",
+            "bench-elements",
+        ],
     ),
     (
         &["--patch-size", "-1"],
         &[
+            "annual",
             "bench-shots",
             "bench-rays",
             "bench-elements",
@@ -123,6 +154,7 @@ const BAD: &[(&[&str], &[&str])] = &[
     (
         &["--patch-size", "nan"],
         &[
+            "annual",
             "bench-shots",
             "bench-rays",
             "bench-elements",
@@ -180,6 +212,17 @@ fn line(cmd: &str, extra: &[&str], dir: &str) -> Vec<String> {
             format!("{dir}/reference"),
         ],
         "info" => vec!["info".into()],
+        "annual" => vec![
+            "annual".into(),
+            "scenes/office.obj".into(),
+            "--weather".into(),
+            format!("{dir}/none.wea"),
+            "--grid".into(),
+            "0.8,1".into(),
+            "-q".into(),
+            "--out".into(),
+            format!("{dir}/annual"),
+        ],
         "crosscheck" => vec!["crosscheck".into(), "--rays".into(), "1000".into()],
         other => panic!("{other} takes a flag of the table: give it a command line here"),
     };

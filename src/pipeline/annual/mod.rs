@@ -85,7 +85,7 @@ pub struct Annual {
 impl AnnualJob {
     /// The solve job as the annual run solves it: the unit sky of daylight coefficients in the
     /// job's orientation and the job's ground reflectance.
-    fn coefficient_job(&self) -> Result<SolveJob, Error> {
+    pub(crate) fn coefficient_job(&self) -> Result<SolveJob, Error> {
         let mut job = self.solve.clone();
         let spec = crate::sky::SkySpec {
             zenith: job.zenith,

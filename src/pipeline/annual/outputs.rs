@@ -19,8 +19,24 @@ pub fn run_and_write(
     log: &mut impl FnMut(&str),
 ) -> Result<Vec<String>, Error> {
     let out = &job.solve.out;
-    std::fs::create_dir_all(out.join("annual"))
-        .map_err(|e| Error::Invalid(format!("{}: cannot create it ({e})", out.display())))?;
+    // Settings first, then the folders (so a refused flag leaves nothing behind); on any
+    // failure the folders made here are taken away again.
+    job.coefficient_job()?;
+    let made = crate::export::prepare_dir(&out.join("annual"))?;
+    let result = run_into(job, progress, log);
+    if result.is_err() {
+        crate::export::remove_made_dirs(&made);
+    }
+    result
+}
+
+/// [`run_and_write`] once the folder is made.
+fn run_into(
+    job: &AnnualJob,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+) -> Result<Vec<String>, Error> {
+    let out = &job.solve.out;
     let mut a = run(job, progress, log)?;
     progress.phase("writing outputs");
     let clock = Clock::start();
