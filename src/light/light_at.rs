@@ -96,10 +96,15 @@ impl<'a, I: Intersector> LightAt<'a, I> {
         let mut kernel = Kernel::new(mesh, materials, isect, sol, sky);
         kernel.sky.sky_weight = sky_weight;
         kernel.sky.sun_weight = sun_weight;
-        LightAt {
-            kernel,
-            facing: (0..mesh.patches.len()).map(|_| OnceLock::new()).collect(),
-        }
+        LightAt::over(kernel)
+    }
+
+    /// The point query over `kernel`, no patch yet asked whether an emitter faces it.
+    fn over(kernel: Kernel<'a, I>) -> Self {
+        let facing = (0..kernel.mesh.patches.len())
+            .map(|_| OnceLock::new())
+            .collect();
+        LightAt { kernel, facing }
     }
 
     /// The light of a daylight-coefficient solve ([`crate::sky::Sky::coefficients`]): `b` and
@@ -124,10 +129,7 @@ impl<'a, I: Intersector> LightAt<'a, I> {
         };
         let mut kernel = Kernel::new(mesh, materials, isect, sol, Some(sky));
         kernel.sky.first_escapes = false;
-        LightAt {
-            kernel,
-            facing: (0..mesh.patches.len()).map(|_| OnceLock::new()).collect(),
-        }
+        LightAt::over(kernel)
     }
 
     /// The daylight coefficients of sensors `(point, facing)`
