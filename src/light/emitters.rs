@@ -88,9 +88,8 @@ pub(crate) struct Emitters {
     roots: Vec<u32>,
     /// Emitters (indices into `patches`) in tree order.
     order: Vec<u32>,
-    /// Per emitter: its place in `order`, and its leaf.
+    /// Per emitter: its place in `order`.
     position: Vec<u32>,
-    leaf_of: Vec<u32>,
     /// Per place in `order`: the cumulative power up to and including it.
     within: Vec<f64>,
 }
@@ -152,10 +151,9 @@ impl Emitters {
             patches: &patches,
             order: &order,
             nodes: Vec::new(),
-            leaf_of: vec![0u32; patches.len()],
         };
         let roots = tree.roots();
-        let (nodes, leaf_of) = (tree.nodes, tree.leaf_of);
+        let nodes = tree.nodes;
         Emitters {
             points: patches.iter().map(|&j| PatchPoints::new(mesh, j)).collect(),
             patches,
@@ -165,7 +163,6 @@ impl Emitters {
             roots,
             order,
             position,
-            leaf_of,
             within,
         }
     }
@@ -322,10 +319,7 @@ impl Emitters {
     /// The probability that `draw` picks emitter `e` (an index into `patches`) of power `w_e`.
     pub fn mass(&self, draw: &Draw, e: usize, w_e: f64) -> f64 {
         match &draw.local {
-            None => {
-                let leaf = &self.nodes[self.leaf_of[e] as usize];
-                leaf.power / self.power * w_e / leaf.power
-            }
+            None => w_e / self.power,
             Some(cut) => {
                 // The node of the cut holding e, if any (none: e cannot light the receiver).
                 let at = self.position[e] as usize;
@@ -378,7 +372,6 @@ struct Tree<'a> {
     patches: &'a [usize],
     order: &'a [u32],
     nodes: Vec<Cluster>,
-    leaf_of: Vec<u32>,
 }
 
 impl Tree<'_> {
@@ -412,18 +405,15 @@ impl Tree<'_> {
     /// The node of `order[start..end]`, its halves built first.
     fn build(&mut self, start: usize, end: usize) -> u32 {
         if end - start == 1 {
-            let mut leaf = cluster(
+            let leaf = cluster(
                 self.mesh,
                 self.e,
                 self.patches,
                 &self.order[start..end],
                 (start, end),
             );
-            leaf.children = None;
             self.nodes.push(leaf);
-            let id = (self.nodes.len() - 1) as u32;
-            self.leaf_of[self.order[start] as usize] = id;
-            return id;
+            return (self.nodes.len() - 1) as u32;
         }
         let mid = start + (end - start) / 2;
         let (a, b) = (self.build(start, mid), self.build(mid, end));
@@ -620,7 +610,6 @@ mod tests {
             roots: vec![4],
             order: vec![0, 1, 2],
             position: vec![0, 1, 2],
-            leaf_of: vec![0, 1, 2],
         }
     }
 
