@@ -16,15 +16,22 @@
 //! on `scenes/spot.obj` (0.4 m patches), corners alone left an error floor of 1.48 % under
 //! every mesh even at 2,048 rays a corner, the quadratic through the nine nodes 0.86 % at 256
 //! (the whole gather at every corner: 0.76 %). README, "Adaptive elements", has the costs.
+//!
+//! **Which nodes.** Every root's corners first (about one distinct point a patch, shared);
+//! only a patch whose corners' indirect light differs by more than [`SPREAD`] gathers its
+//! midpoints and centre and is interpolated quadratically, the others bilinearly: where the
+//! corners agree, the light between them is as flat as the noise can tell.
 
 use super::geometry::Elem;
 use super::work::{At, PatchWork, Values};
+use crate::solve::scalar;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use std::collections::HashSet;
 
 /// The nodes of root element `e`'s quadratic: its corners, then its edge midpoints (edge k
-/// from corner k), then a quad's centre — the points of its first midpoint test.
+/// from corner k), then a quad's centre — the points of its first midpoint test. The first
+/// `e.count()` are the corners, all a root whose indirect light is smooth keeps.
 fn nodes(e: &Elem) -> Vec<DVec2> {
     let uv = e.corners_uv();
     let n = uv.len();
@@ -37,42 +44,48 @@ fn nodes(e: &Elem) -> Vec<DVec2> {
 }
 
 /// The indirect light at parameters `uv` of a root whose nodes have the values `f` (in the
-/// order of `nodes`; a patch's [`PatchWork::ind_nodes`]): the quadratic through them
-/// (biquadratic on a quad's 3 × 3, the six-node quadratic on a triangle), not below 0.
+/// order of `nodes`; a patch's [`PatchWork::ind_nodes`]): bilinear from a quad's 4 corners,
+/// affine from a triangle's 3, the quadratic through all the nodes (biquadratic on a quad's
+/// 3 × 3, the six-node quadratic on a triangle); not below 0.
 pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
     let (u, v) = (uv.x, uv.y);
-    let weights: Vec<f64> = if f.len() == 9 {
-        let l = |t: f64| {
-            [
-                2.0 * (t - 0.5) * (t - 1.0),
-                -4.0 * t * (t - 1.0),
-                2.0 * t * (t - 0.5),
+    let weights: Vec<f64> = match f.len() {
+        3 => vec![1.0 - u - v, u, v],
+        4 => vec![(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v],
+        9 => {
+            let l = |t: f64| {
+                [
+                    2.0 * (t - 0.5) * (t - 1.0),
+                    -4.0 * t * (t - 1.0),
+                    2.0 * t * (t - 0.5),
+                ]
+            };
+            let (lu, lv) = (l(u), l(v));
+            // Node order of `nodes`: (i, j) on the 3 × 3 grid of u, v ∈ {0, ½, 1}.
+            let grid = [
+                (0, 0),
+                (2, 0),
+                (2, 2),
+                (0, 2),
+                (1, 0),
+                (2, 1),
+                (1, 2),
+                (0, 1),
+                (1, 1),
+            ];
+            grid.iter().map(|&(i, j)| lu[i] * lv[j]).collect()
+        }
+        _ => {
+            let (a, b, c) = (1.0 - u - v, u, v);
+            vec![
+                a * (2.0 * a - 1.0),
+                b * (2.0 * b - 1.0),
+                c * (2.0 * c - 1.0),
+                4.0 * a * b,
+                4.0 * b * c,
+                4.0 * c * a,
             ]
-        };
-        let (lu, lv) = (l(u), l(v));
-        // Node order of `nodes`: (i, j) on the 3 × 3 grid of u, v ∈ {0, ½, 1}.
-        let grid = [
-            (0, 0),
-            (2, 0),
-            (2, 2),
-            (0, 2),
-            (1, 0),
-            (2, 1),
-            (1, 2),
-            (0, 1),
-            (1, 1),
-        ];
-        grid.iter().map(|&(i, j)| lu[i] * lv[j]).collect()
-    } else {
-        let (a, b, c) = (1.0 - u - v, u, v);
-        vec![
-            a * (2.0 * a - 1.0),
-            b * (2.0 * b - 1.0),
-            c * (2.0 * c - 1.0),
-            4.0 * a * b,
-            4.0 * b * c,
-            4.0 * c * a,
-        ]
+        }
     };
     let mut out = [0.0; 3];
     for (x, wt) in f.iter().zip(&weights) {
@@ -83,33 +96,25 @@ pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
     out.map(|x| x.max(0.0))
 }
 
-/// Gathers the indirect light at the nodes of every patch's roots (each distinct point once,
-/// by the lowest-numbered patch that has it; in parallel), into `values.indirect`, and sets
-/// each patch's [`PatchWork::ind_nodes`]. `at(patch, work, root, uv)` says where a point's
-/// value is kept and where it is gathered; `indirect(patch, x)` gathers the indirect light
-/// at `x` as that patch, with the rays it cost.
-pub(super) fn gather(
-    work: &mut [PatchWork],
-    at: impl Fn(usize, &PatchWork, u32, DVec2) -> (At, DVec3) + Sync,
-    indirect: impl Fn(usize, DVec3) -> ([f64; 3], u64) + Sync,
+/// A patch whose corners' indirect light differs by more than this fraction of their mean
+/// gathers the rest of its nodes (edge midpoints, a quad's centre) and is interpolated
+/// quadratically; below it, bilinearly from its corners (0.05 and 0.1 measured alike on
+/// `scenes/spot.obj`; docs/results/adaptive-elements.md).
+pub const SPREAD: f64 = 0.1;
+
+/// Gathers each distinct point of `points` that `values.indirect` lacks, once (by the first
+/// patch listing it), in parallel.
+fn gather_points(
+    points: &[(usize, Vec<(At, DVec3)>)],
+    indirect: &(impl Fn(usize, DVec3) -> ([f64; 3], u64) + Sync),
     values: &mut Values,
 ) {
-    let points = |i: usize, w: &PatchWork| -> Vec<Vec<(At, DVec3)>> {
-        (w.roots.iter().enumerate())
-            .map(|(k, root)| {
-                let e = root.element(k as u32);
-                (nodes(&e).into_iter())
-                    .map(|uv| at(i, w, k as u32, uv))
-                    .collect()
-            })
-            .collect()
-    };
     let mut seen = HashSet::new();
     let mut todo = Vec::new();
-    for (i, w) in work.iter().enumerate() {
-        for (at, x) in points(i, w).into_iter().flatten() {
-            if seen.insert(at) {
-                todo.push((at, i, x));
+    for (i, list) in points {
+        for &(at, x) in list {
+            if !values.indirect.contains_key(&at) && seen.insert(at) {
+                todo.push((at, *i, x));
             }
         }
     }
@@ -118,9 +123,53 @@ pub(super) fn gather(
         values.indirect.insert(at, b);
         values.rays += n;
     }
+}
+
+/// Gathers the indirect light at the nodes of every patch's roots into `values.indirect`
+/// and sets each patch's [`PatchWork::ind_nodes`]: first every root's corners (each distinct
+/// point once, by the lowest-numbered patch that has it; in parallel), then the other nodes
+/// of the patches whose corners' indirect light differs by more than [`SPREAD`] of their
+/// mean. `at(patch, work, root, uv)` says where a point's value is kept and where it is
+/// gathered; `indirect(patch, x)` gathers the indirect light at `x` as that patch, with the
+/// rays it cost.
+pub(super) fn gather(
+    work: &mut [PatchWork],
+    at: impl Fn(usize, &PatchWork, u32, DVec2) -> (At, DVec3) + Sync,
+    indirect: impl Fn(usize, DVec3) -> ([f64; 3], u64) + Sync,
+    values: &mut Values,
+) {
+    // Per patch, per root: its nodes, the corners only unless `all`.
+    let points = |i: usize, w: &PatchWork, all: bool| -> Vec<Vec<(At, DVec3)>> {
+        (w.roots.iter().enumerate())
+            .map(|(k, root)| {
+                let e = root.element(k as u32);
+                let keep = if all { usize::MAX } else { e.count() };
+                (nodes(&e).into_iter().take(keep))
+                    .map(|uv| at(i, w, k as u32, uv))
+                    .collect()
+            })
+            .collect()
+    };
+    let corners: Vec<(usize, Vec<(At, DVec3)>)> = (work.par_iter().enumerate())
+        .map(|(i, w)| (i, points(i, w, false).concat()))
+        .collect();
+    gather_points(&corners, &indirect, values);
+    let v = &*values;
+    let all: Vec<bool> = (corners.par_iter())
+        .map(|(_, list)| {
+            let s: Vec<f64> = list.iter().map(|(a, _)| scalar(&v.indirect[a])).collect();
+            let (lo, hi) = (s.iter()).fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+            hi - lo > SPREAD * s.iter().sum::<f64>() / s.len().max(1) as f64
+        })
+        .collect();
+    let rest: Vec<(usize, Vec<(At, DVec3)>)> = (work.par_iter().enumerate())
+        .filter(|(i, _)| all[*i])
+        .map(|(i, w)| (i, points(i, w, true).concat()))
+        .collect();
+    gather_points(&rest, &indirect, values);
     let v = &*values;
     work.par_iter_mut().enumerate().for_each(|(i, w)| {
-        w.ind_nodes = (points(i, w).into_iter())
+        w.ind_nodes = (points(i, w, all[i]).into_iter())
             .map(|root| root.iter().map(|(at, _)| v.indirect[at]).collect())
             .collect();
     });

@@ -45,10 +45,12 @@ pub use refine::{CornerLight, Rule, Stop, Test};
 pub const DEFAULT_THRESHOLD: f64 = 0.02;
 /// Default smallest element, as a fraction of the patch size.
 pub const DEFAULT_MIN_FRACTION: f32 = 1.0 / 8.0;
-/// Default `--element-rays`: rays of each corner's gather (at 128 the corners' own noise,
-/// about 1.1 % on `scenes/spot.obj`, is a floor the meshing cannot go under: 0.53 of uniform
-/// meshing's error at the same count, 0.47 at 256; at 64 it shows as faint blotches).
-pub const DEFAULT_RAYS: usize = 256;
+/// Default `--element-rays`: with the default [`CornerLight::Split`], the rays of each
+/// indirect node's gather, half as many for each corner's direct light. With the patches
+/// setting the level (`display`'s notes) 64 reach the error [`CornerLight::Full`] had at 256
+/// on `scenes/spot.obj` (docs/results/adaptive-elements.md); [`CornerLight::Full`] wants
+/// 256 (at 128 the corners' own noise is a floor the meshing cannot go under).
+pub const DEFAULT_RAYS: usize = 64;
 /// Default cap on the elements, as a multiple of the patches.
 pub const DEFAULT_MAX_FACTOR: f64 = 8.0;
 /// `--elements auto` (the default) refines the elements of meshes up to this many patches
@@ -95,7 +97,7 @@ impl Default for ElementSettings {
             rays: DEFAULT_RAYS,
             max_factor: DEFAULT_MAX_FACTOR,
             test: Test::Halves,
-            light: CornerLight::Full,
+            light: CornerLight::Split,
         }
     }
 }
@@ -358,10 +360,11 @@ pub fn refine_by<I: Intersector>(
         gather,
         b,
         seed,
-        // Split: a quarter of the rays to each corner's direct light, all of them to each
-        // node of the indirect light (README, "Adaptive elements").
+        // Split: half the rays to each corner's direct light, all of them to each node of the
+        // indirect light (docs/results/adaptive-elements.md: a quarter was measured alike at
+        // 256, worse at 64).
         rays: if light == CornerLight::Split {
-            (rays / 4).max(2)
+            (rays / 2).max(2)
         } else {
             rays
         },

@@ -87,7 +87,8 @@ pub struct ElementArgs {
     /// The smallest element edge, metres [default: the patch size / 8].
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     element_min_size: Option<f32>,
-    /// Rays of each element corner's gather.
+    /// Rays of each element corner's gather (split: of each indirect node's, half as many
+    /// for each corner's direct light; full wants 256).
     #[arg(long, value_name = "N", default_value_t = elements::DEFAULT_RAYS)]
     element_rays: usize,
     /// At most this many elements per patch in all (the largest differences are cut first).
@@ -100,12 +101,13 @@ pub struct ElementArgs {
     /// between its corners, cut in four).
     #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().test)]
     element_test: elements::Test,
-    /// What each corner gathers: full (the whole light, direct and hemisphere rays) or
-    /// direct (the emitters' and the sun's light by shadow rays; the indirect light
-    /// interpolated from the patch solution: about a quarter of the rays, a preview that
-    /// misses the indirect light's contact shadows) or split (the direct light at every
-    /// corner, the indirect light gathered at nine nodes of each patch and interpolated
-    /// quadratically: about a third of full's rays, a little more error).
+    /// What each corner gathers: split (the direct light at every corner, the indirect
+    /// light gathered at each patch's corners, and at its edge midpoints and centre where
+    /// those differ, interpolated beneath), full (the whole light, direct and hemisphere
+    /// rays, at every corner: about 7× split's rays at 256) or direct (the emitters' and the
+    /// sun's light by shadow rays; the indirect light interpolated from the patch solution: a
+    /// preview that misses the indirect light's contact shadows). Every patch's elements are
+    /// scaled to its solved radiosity on average.
     #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().light)]
     element_light: elements::CornerLight,
 }
