@@ -54,10 +54,11 @@ pub const DEFAULT_RAYS: usize = 64;
 /// Default cap on the elements, as a multiple of the patches.
 pub const DEFAULT_MAX_FACTOR: f64 = 8.0;
 /// `--elements auto` (the default) refines the elements of meshes up to this many patches
-/// and skips them, with a line, above: their cost grows with the patches, about 1.1–1.3 ms a
-/// patch on 2 cores (6.0 s for the 5,267-patch church; 28.6 s for the furnished office's
-/// 21,801 patches, whose solve takes 20 s), so a big model's picture is the final gather's.
-pub const AUTO_MAX_PATCHES: u64 = 10_000;
+/// and skips them, with a line, above, where their cost is not yet measured: on the
+/// furnished office's 21,801 patches they cast 53 M rays against its solve's 166 M (about a
+/// third of its CPU time; docs/results/adaptive-elements.md), so a bigger model's picture is
+/// the final gather's until a bigger one is measured.
+pub const AUTO_MAX_PATCHES: u64 = 25_000;
 /// Below this fraction of the scene's mean radiosity, differences count as if at it (dark
 /// corners are not refined for noise).
 pub const FLOOR: f64 = 1e-3;

@@ -74,7 +74,7 @@ pub struct SolveArgs {
 pub struct ElementArgs {
     /// After the solve, cut each patch into elements where its light changes (shadow edges,
     /// corners, beside lights), each corner's radiosity gathered with rays; the picture,
-    /// the exports and elements.csv use them. auto: on for meshes of up to 10,000 patches;
+    /// the exports and elements.csv use them. auto: on for meshes of up to 25,000 patches;
     /// off: the elements are the patches.
     #[arg(long, value_enum, default_value_t = ElementsArg::Auto, value_name = "auto|on|off")]
     elements: ElementsArg,
