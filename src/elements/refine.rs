@@ -3,8 +3,8 @@
 //! in four, level by level, until none is, or they reach the minimum size.
 //!
 //! **Values at the corners.** Cohen 1986 computes the radiosity at element vertices by
-//! hemi-cubes placed there, with the patches as the light's sources. Here each corner gathers
-//! the whole light ([`CornerLight::Full`], the default; [`LightAt::radiosity_at`]): the
+//! hemi-cubes placed there, with the patches as the light's sources. Here each corner may gather
+//! the whole light ([`CornerLight::Full`]; [`LightAt::radiosity_at`]): the
 //! emitters and the sun by shadow rays at the point, the rest over the hemisphere, with the
 //! patch solution as the cache of the indirect light. [`CornerLight::Direct`] gathers only
 //! the direct light there ([`LightAt::part_at`]: the part with the shadow edges and the peaks
@@ -14,17 +14,21 @@
 //! rays, but the indirect light's own variation within a patch (contact shadows, under a
 //! table) is then neither seen by the test nor shown: on `scenes/spot.obj` it leaves a floor
 //! of 1.6 % under every mesh's error, where the full gather's is under 1 %.
-//! [`CornerLight::Split`] gathers the direct light at every point too, and the indirect part
-//! at nine nodes of each patch, interpolated quadratically beneath (`elements/indirect.rs`): the
-//! contact shadows' fall-off is seen at the patch's scale, for about a third of the full
-//! gather's rays.
+//! [`CornerLight::Split`] (the default) gathers the direct light at every point too, and the
+//! indirect part only on the patches that see geometry near enough to shape it (Ward's
+//! split-sphere criterion, `elements/indirect.rs`), at their corners and, where those differ,
+//! at nine nodes, interpolated beneath: the contact shadows' fall-off is seen at the patch's
+//! scale; every other patch's indirect light is the patch solution's, as under
+//! [`CornerLight::Direct`].
 //!
 //! **Shared points.** A point that no patch boundary of its surface runs through — inside a
 //! patch, or on an edge two patches share — has one value for every patch that has it,
 //! gathered once (by the lowest-numbered patch that asks). A point on a patch's edge that no
-//! neighbour shares (a room's edge, where the floor meets a wall) is each patch's own, and is
-//! gathered at a point moved [`INSET`] of the way towards its patch's centre, so that a corner
-//! in a room's edge does not cast its rays from inside the wall beside it.
+//! neighbour of its surface shares (a room's edge, where the floor meets a wall) is gathered
+//! at a point moved [`INSET`] of the way towards the asking patch's centre, so that a corner
+//! in a room's edge does not cast its rays from inside the wall beside it; it too is kept by
+//! position, facing and material, once for the patches along that edge that have it (the
+//! display welds them into one vertex anyway, and the insets differ by 0.2 % of a patch).
 //!
 //! **Common random numbers.** Every point of one scene polygon is gathered with a generator
 //! seeded alike, from (seed, [`Stream::Elements`], polygon): neighbouring corners then use the
@@ -74,12 +78,13 @@ pub enum CornerLight {
     /// The whole gather at every corner (direct and hemisphere rays).
     #[value(help = crate::settings::NO_HELP)]
     Full,
-    /// The direct light at every corner (half of `--element-rays`); the indirect light
+    /// The direct light at every corner (3/8 of `--element-rays`); the indirect light,
+    /// on the patches that see geometry near enough to shape it (`indirect::near_patches`),
     /// gathered (with all of them) at each patch's corners, shared with its neighbours, and
     /// where they differ at its edge midpoints and centre too, interpolated across its
-    /// elements (bilinearly, or quadratically through the nine). The default: at 64 rays,
-    /// 0.14 of [`CornerLight::Full`]'s rays at 256 on the office, the same error on
-    /// `scenes/spot.obj`.
+    /// elements (bilinearly, or quadratically through the nine); on the others, the patch
+    /// solution's, as [`CornerLight::Direct`] takes it. The default: at 64 rays, 0.07 of
+    /// [`CornerLight::Full`]'s rays at 256 on the office (docs/results/adaptive-elements.md).
     #[default]
     #[value(help = crate::settings::NO_HELP)]
     Split,
@@ -141,6 +146,10 @@ pub(super) struct Refiner<'a, I> {
     pub light: CornerLight,
     /// [`CornerLight::Split`]: rays of each patch corner's indirect gather.
     pub indirect_rays: usize,
+    /// [`CornerLight::Split`]: per patch, whether it gathers the indirect light at its nodes
+    /// (`indirect::near_patches`); the others', and every patch's under
+    /// [`CornerLight::Direct`], is interpolated from the patch solution.
+    pub near: Vec<bool>,
     pub quantum: f64,
     /// Per patch, bit k set: its edge k (corner k to k + 1) is shared with a neighbour
     /// ([`inner_edges`]).
@@ -258,6 +267,17 @@ struct Deviation {
 }
 
 impl<I: Intersector> Refiner<'_, I> {
+    /// Whether patch `patch`'s points hold its indirect light (gathered at its nodes, or in
+    /// the whole gather): otherwise their values are the direct light, and the indirect is
+    /// added from the patch solution when the refinement ends ([`finish`]).
+    fn gathers_indirect(&self, patch: usize) -> bool {
+        match self.light {
+            CornerLight::Full => true,
+            CornerLight::Direct => false,
+            CornerLight::Split => self.near[patch],
+        }
+    }
+
     /// Whether Ctrl-C or the deadline asks to stop.
     pub fn stopped(&self) -> bool {
         self.stop.interrupted() || self.stop.out_of_time()
@@ -271,13 +291,14 @@ impl<I: Intersector> Refiner<'_, I> {
         let k = key(p, self.quantum);
         let pt = &self.mesh.patches[patch];
         let n = pt.count as usize;
+        let at = At(k, facing(pt.normal), pt.material);
         let shared =
             on_edges(n, root as usize, r.tri, uv).is_some_and(|m| m & !self.inner[patch] == 0);
         if shared {
-            (At::Shared(k, facing(pt.normal), pt.material), p)
+            (at, p)
         } else {
             let c = pt.centre.as_dvec3();
-            (At::Own(patch as u32, k), p + (c - p) * INSET)
+            (at, p + (c - p) * INSET)
         }
     }
 
@@ -285,7 +306,8 @@ impl<I: Intersector> Refiner<'_, I> {
     fn value(&self, patch: usize, w: &PatchWork, root: u32, uv: DVec2, v: &Values) -> [f64; 3] {
         let (at, _) = self.at(patch, w, root, uv);
         let b = v.map.get(&at).copied().unwrap_or([0.0; 3]);
-        if self.light != CornerLight::Split {
+        // Split corners' gathered indirect light is at the nodes; Full's is in `b`.
+        if self.light != CornerLight::Split || !self.near[patch] {
             return b;
         }
         let ind = super::indirect::at(&w.ind_nodes[root as usize], uv);
@@ -496,7 +518,7 @@ impl<I: Intersector> Refiner<'_, I> {
         // The direct light's differences against the whole light there: the root's first
         // test gives its indirect part (the patch's radiosity less the direct light's mean).
         let r = e.root as usize;
-        if self.light == CornerLight::Direct && e.depth == 0 {
+        if !self.gathers_indirect(patch) && e.depth == 0 {
             w.indirect[r] = (scalar(&self.b[patch]) - mean).max(0.0);
         }
         let whole = corners_mean + w.indirect[r];
@@ -544,9 +566,10 @@ fn interpolate(at: &[[f32; 3]], root: usize, tri: bool, uv: DVec2) -> [f64; 3] {
 }
 
 /// Gathers the kept elements' corners and sets every patch's [`PatchWork::corner_b`]: the
-/// gathered values, plus, for [`CornerLight::Direct`], the indirect light interpolated from
-/// the patches' (their radiosity less the mean of their elements' direct light, averaged to
-/// the welded vertices).
+/// gathered values, plus, where they are the direct light alone ([`CornerLight::Direct`], and
+/// the patches of [`CornerLight::Split`] that gather no indirect nodes), the indirect light
+/// interpolated from the patches' (their radiosity less the mean of their elements' direct
+/// light, averaged to the welded vertices).
 pub(super) fn finish<I: Intersector>(
     r: &Refiner<'_, I>,
     work: &mut [PatchWork],
@@ -561,53 +584,61 @@ pub(super) fn finish<I: Intersector>(
         .collect();
     r.gather_all(work, &want, values);
     let v = &*values;
+    // Per patch, its kept corners' direct light (what `values.map` holds).
     let direct: Vec<Vec<[f64; 3]>> = (work.par_iter().enumerate())
         .map(|(i, w)| {
             (w.done.iter())
                 .flat_map(|e| {
-                    e.corners_uv()
-                        .iter()
-                        .map(move |&uv| r.value(i, w, e.root, uv, v))
+                    e.corners_uv().iter().map(move |&uv| {
+                        let (at, _) = r.at(i, w, e.root, uv);
+                        v.map.get(&at).copied().unwrap_or([0.0; 3])
+                    })
                 })
                 .collect()
         })
         .collect();
-    let indirect: Vec<[f32; 3]> = match r.light {
-        CornerLight::Full | CornerLight::Split => Vec::new(),
-        CornerLight::Direct => {
-            let own: Vec<[f64; 3]> = (work.iter().zip(&direct).enumerate())
-                .map(|(i, (w, d))| {
-                    let (mut s, mut a) = ([0.0f64; 3], 0.0);
-                    let mut k = 0;
-                    for e in &w.done {
-                        let n = e.count();
-                        let ae = e.share() * root_area(&w.roots[e.root as usize]);
-                        for dv in &d[k..k + n] {
-                            for c in 0..3 {
-                                s[c] += ae * dv[c] / n as f64;
-                            }
+    let indirect: Vec<[f32; 3]> = if (0..work.len()).all(|i| r.gathers_indirect(i)) {
+        Vec::new()
+    } else {
+        let own: Vec<[f64; 3]> = (work.iter().zip(&direct).enumerate())
+            .map(|(i, (w, d))| {
+                let (mut s, mut a) = ([0.0f64; 3], 0.0);
+                let mut k = 0;
+                for e in &w.done {
+                    let n = e.count();
+                    let ae = e.share() * root_area(&w.roots[e.root as usize]);
+                    for dv in &d[k..k + n] {
+                        for c in 0..3 {
+                            s[c] += ae * dv[c] / n as f64;
                         }
-                        a += ae;
-                        k += n;
                     }
-                    let mean = s.map(|x| if a > 0.0 { x / a } else { 0.0 });
-                    [0, 1, 2].map(|c| r.b[i][c] - mean[c])
-                })
-                .collect();
-            r.mesh.vertex_values(&own)
-        }
+                    a += ae;
+                    k += n;
+                }
+                let mean = s.map(|x| if a > 0.0 { x / a } else { 0.0 });
+                [0, 1, 2].map(|c| r.b[i][c] - mean[c])
+            })
+            .collect();
+        r.mesh.vertex_values(&own)
     };
     work.par_iter_mut()
         .zip(direct)
         .enumerate()
         .for_each(|(i, (w, d))| {
+            if r.gathers_indirect(i) {
+                w.corner_b = (w.done.iter())
+                    .flat_map(|e| {
+                        e.corners_uv()
+                            .iter()
+                            .map(|&uv| r.value(i, w, e.root, uv, v))
+                    })
+                    .collect();
+                return;
+            }
             w.corner_b = d;
-            let at: Vec<[f32; 3]> = match r.light {
-                CornerLight::Full | CornerLight::Split => return,
-                CornerLight::Direct => (r.mesh.patch_indices(i).iter())
-                    .map(|&k| indirect[k as usize])
-                    .collect(),
-            };
+            let at: Vec<[f32; 3]> = (r.mesh.patch_indices(i).iter())
+                .map(|&k| indirect[k as usize])
+                .collect();
             let mut k = 0;
             for e in &w.done {
                 let tri = w.roots[e.root as usize].tri;
@@ -660,6 +691,7 @@ pub(super) fn run<I: Intersector>(
     if r.light == CornerLight::Split {
         super::indirect::gather(
             &mut work,
+            &r.near,
             |i, w, root, uv| r.at(i, w, root, uv),
             |i, x| r.gather_part(i, x, LightParts::Indirect, r.indirect_rays),
             &mut values,

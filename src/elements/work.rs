@@ -6,15 +6,10 @@
 use super::geometry::{Elem, Root};
 use std::collections::HashMap;
 
-/// Where a point's value is kept ([`super::refine`]'s notes, "Shared points").
+/// Where a point's value is kept ([`super::refine`]'s notes, "Shared points"): its position,
+/// facing and material, as the mesh welds its vertices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(super) enum At {
-    /// A point of a surface no patch boundary runs through: position, facing, material (as
-    /// the mesh welds its vertices).
-    Shared([i64; 3], [i32; 3], u32),
-    /// A point on an edge of this patch that no neighbour shares.
-    Own(u32, [i64; 3]),
-}
+pub(super) struct At(pub [i64; 3], pub [i32; 3], pub u32);
 
 /// The values gathered so far, and the rays they cost.
 #[derive(Default)]
