@@ -64,8 +64,26 @@ fn nodes(e: &Elem) -> Vec<DVec2> {
 /// affine from a triangle's 3, the quadratic through all the nodes (biquadratic on a quad's
 /// 3 × 3, the six-node quadratic on a triangle); not below 0.
 pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
+    let mut out = [0.0; 3];
+    for (x, wt) in f.iter().zip(weights(f.len(), uv)) {
+        for c in 0..3 {
+            out[c] += wt * x[c];
+        }
+    }
+    out.map(|x| x.max(0.0))
+}
+
+/// The variance of [`at`]'s value from independent nodes of variances `var`: Σ wₖ² σₖ².
+pub(super) fn var_at(var: &[f64], uv: DVec2) -> f64 {
+    (var.iter().zip(weights(var.len(), uv)))
+        .map(|(v, wt)| wt * wt * v)
+        .sum()
+}
+
+/// The weights of [`at`]'s interpolation from `n` nodes at `uv`.
+fn weights(n: usize, uv: DVec2) -> Vec<f64> {
     let (u, v) = (uv.x, uv.y);
-    let weights: Vec<f64> = match f.len() {
+    match n {
         3 => vec![1.0 - u - v, u, v],
         4 => vec![(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v],
         9 => {
@@ -102,14 +120,7 @@ pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
                 4.0 * c * a,
             ]
         }
-    };
-    let mut out = [0.0; 3];
-    for (x, wt) in f.iter().zip(&weights) {
-        for c in 0..3 {
-            out[c] += wt * x[c];
-        }
     }
-    out.map(|x| x.max(0.0))
 }
 
 /// A patch whose corners' indirect light differs by more than this fraction of their mean
@@ -122,7 +133,7 @@ pub const SPREAD: f64 = 0.3;
 /// patch listing it), in parallel.
 fn gather_points(
     points: &[(usize, Vec<(At, DVec3)>)],
-    indirect: &(impl Fn(usize, DVec3) -> ([f64; 3], u64) + Sync),
+    indirect: &(impl Fn(usize, DVec3) -> ([f64; 3], f64, u64) + Sync),
     values: &mut Values,
 ) {
     let mut seen = HashSet::new();
@@ -134,9 +145,10 @@ fn gather_points(
             }
         }
     }
-    let got: Vec<([f64; 3], u64)> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
-    for ((at, _, _), (b, n)) in todo.into_iter().zip(got) {
+    let got: Vec<_> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
+    for ((at, _, _), (b, var, n)) in todo.into_iter().zip(got) {
         values.indirect.insert(at, b);
+        values.indirect_var.insert(at, var);
         values.rays += n;
     }
 }
@@ -153,7 +165,7 @@ pub(super) fn gather(
     work: &mut [PatchWork],
     near: &[bool],
     at: impl Fn(usize, &PatchWork, u32, DVec2) -> (At, DVec3) + Sync,
-    indirect: impl Fn(usize, DVec3) -> ([f64; 3], u64) + Sync,
+    indirect: impl Fn(usize, DVec3) -> ([f64; 3], f64, u64) + Sync,
     values: &mut Values,
 ) {
     // Per patch, per root: its nodes, the corners only unless `all`.
@@ -190,8 +202,12 @@ pub(super) fn gather(
         if !near[i] {
             return;
         }
-        w.ind_nodes = (points(i, w, all[i]).into_iter())
+        let pts = points(i, w, all[i]);
+        w.ind_nodes = (pts.iter())
             .map(|root| root.iter().map(|(at, _)| v.indirect[at]).collect())
+            .collect();
+        w.ind_var = (pts.iter())
+            .map(|root| root.iter().map(|(at, _)| v.indirect_var[at]).collect())
             .collect();
     });
 }
