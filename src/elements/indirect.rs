@@ -16,15 +16,38 @@
 //! on `scenes/spot.obj` (0.4 m patches), corners alone left an error floor of 1.48 % under
 //! every mesh even at 2,048 rays a corner, the quadratic through the nine nodes 0.86 % at 256
 //! (the whole gather at every corner: 0.76 %). README, "Adaptive elements", has the costs.
+//!
+//! **Which patches.** Only those that see geometry near enough to bend their indirect light
+//! within them ([`near_patches`]: Ward, Rubinstein & Clear's criterion from the harmonic mean
+//! distance of what a patch sees, measured with a few probe rays). Elsewhere the indirect light
+//! is as smooth as the patch solution draws it, and the final gather has measured every
+//! patch's B with more rays than a node gets: such a patch's points gather the direct light
+//! only, its indirect light is the patch solution's (B less its elements' mean direct light,
+//! averaged to the welded vertices, as [`super::CornerLight::Direct`] takes it), at no
+//! hemisphere ray. On the office 803 of 2,092 patches gather nodes; on `scenes/spot.obj` that
+//! lowered the error too (1.19 → 1.14 % at the default mesh: the patches' estimates are less
+//! noisy than 64-ray nodes; docs/results/adaptive-elements.md).
+//!
+//! **Which nodes.** Every root's corners first (about one distinct point a patch, shared);
+//! only a patch whose corners' indirect light differs by more than [`SPREAD`] gathers its
+//! midpoints and centre and is interpolated quadratically, the others bilinearly: where the
+//! corners agree, the light between them is as flat as the noise can tell.
 
 use super::geometry::Elem;
 use super::work::{At, PatchWork, Values};
-use glam::{DVec2, DVec3};
+use crate::intersect::Intersector;
+use crate::light::LightAt;
+use crate::mesh::Mesh;
+use crate::sample::Frame;
+use crate::solve::{rng_for, scalar, Stream};
+use glam::{DVec2, DVec3, Vec3};
+use rand::Rng;
 use rayon::prelude::*;
 use std::collections::HashSet;
 
 /// The nodes of root element `e`'s quadratic: its corners, then its edge midpoints (edge k
-/// from corner k), then a quad's centre — the points of its first midpoint test.
+/// from corner k), then a quad's centre — the points of its first midpoint test. The first
+/// `e.count()` are the corners, all a root whose indirect light is smooth keeps.
 fn nodes(e: &Elem) -> Vec<DVec2> {
     let uv = e.corners_uv();
     let n = uv.len();
@@ -37,45 +60,12 @@ fn nodes(e: &Elem) -> Vec<DVec2> {
 }
 
 /// The indirect light at parameters `uv` of a root whose nodes have the values `f` (in the
-/// order of `nodes`; a patch's [`PatchWork::ind_nodes`]): the quadratic through them
-/// (biquadratic on a quad's 3 × 3, the six-node quadratic on a triangle), not below 0.
+/// order of `nodes`; a patch's [`PatchWork::ind_nodes`]): bilinear from a quad's 4 corners,
+/// affine from a triangle's 3, the quadratic through all the nodes (biquadratic on a quad's
+/// 3 × 3, the six-node quadratic on a triangle); not below 0.
 pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
-    let (u, v) = (uv.x, uv.y);
-    let weights: Vec<f64> = if f.len() == 9 {
-        let l = |t: f64| {
-            [
-                2.0 * (t - 0.5) * (t - 1.0),
-                -4.0 * t * (t - 1.0),
-                2.0 * t * (t - 0.5),
-            ]
-        };
-        let (lu, lv) = (l(u), l(v));
-        // Node order of `nodes`: (i, j) on the 3 × 3 grid of u, v ∈ {0, ½, 1}.
-        let grid = [
-            (0, 0),
-            (2, 0),
-            (2, 2),
-            (0, 2),
-            (1, 0),
-            (2, 1),
-            (1, 2),
-            (0, 1),
-            (1, 1),
-        ];
-        grid.iter().map(|&(i, j)| lu[i] * lv[j]).collect()
-    } else {
-        let (a, b, c) = (1.0 - u - v, u, v);
-        vec![
-            a * (2.0 * a - 1.0),
-            b * (2.0 * b - 1.0),
-            c * (2.0 * c - 1.0),
-            4.0 * a * b,
-            4.0 * b * c,
-            4.0 * c * a,
-        ]
-    };
     let mut out = [0.0; 3];
-    for (x, wt) in f.iter().zip(&weights) {
+    for (x, wt) in f.iter().zip(weights(f.len(), uv)) {
         for c in 0..3 {
             out[c] += wt * x[c];
         }
@@ -83,47 +73,196 @@ pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
     out.map(|x| x.max(0.0))
 }
 
-/// Gathers the indirect light at the nodes of every patch's roots (each distinct point once,
-/// by the lowest-numbered patch that has it; in parallel), into `values.indirect`, and sets
-/// each patch's [`PatchWork::ind_nodes`]. `at(patch, work, root, uv)` says where a point's
-/// value is kept and where it is gathered; `indirect(patch, x)` gathers the indirect light
-/// at `x` as that patch, with the rays it cost.
-pub(super) fn gather(
-    work: &mut [PatchWork],
-    at: impl Fn(usize, &PatchWork, u32, DVec2) -> (At, DVec3) + Sync,
-    indirect: impl Fn(usize, DVec3) -> ([f64; 3], u64) + Sync,
+/// The variance of [`at`]'s value from independent nodes of variances `var`: Σ wₖ² σₖ².
+pub(super) fn var_at(var: &[f64], uv: DVec2) -> f64 {
+    (var.iter().zip(weights(var.len(), uv)))
+        .map(|(v, wt)| wt * wt * v)
+        .sum()
+}
+
+/// The weights of [`at`]'s interpolation from `n` nodes at `uv`.
+fn weights(n: usize, uv: DVec2) -> Vec<f64> {
+    let (u, v) = (uv.x, uv.y);
+    match n {
+        3 => vec![1.0 - u - v, u, v],
+        4 => vec![(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v],
+        9 => {
+            let l = |t: f64| {
+                [
+                    2.0 * (t - 0.5) * (t - 1.0),
+                    -4.0 * t * (t - 1.0),
+                    2.0 * t * (t - 0.5),
+                ]
+            };
+            let (lu, lv) = (l(u), l(v));
+            // Node order of `nodes`: (i, j) on the 3 × 3 grid of u, v ∈ {0, ½, 1}.
+            let grid = [
+                (0, 0),
+                (2, 0),
+                (2, 2),
+                (0, 2),
+                (1, 0),
+                (2, 1),
+                (1, 2),
+                (0, 1),
+                (1, 1),
+            ];
+            grid.iter().map(|&(i, j)| lu[i] * lv[j]).collect()
+        }
+        _ => {
+            let (a, b, c) = (1.0 - u - v, u, v);
+            vec![
+                a * (2.0 * a - 1.0),
+                b * (2.0 * b - 1.0),
+                c * (2.0 * c - 1.0),
+                4.0 * a * b,
+                4.0 * b * c,
+                4.0 * c * a,
+            ]
+        }
+    }
+}
+
+/// A patch whose corners' indirect light differs by more than this fraction of their mean
+/// gathers the rest of its nodes (edge midpoints, a quad's centre) and is interpolated
+/// quadratically; below it, bilinearly from its corners (0.05–0.3 measured alike on
+/// `scenes/spot.obj`, 0.3 the fewest rays; docs/results/adaptive-elements.md).
+pub const SPREAD: f64 = 0.3;
+
+/// Gathers each distinct point of `points` that `values.indirect` lacks, once (by the first
+/// patch listing it), in parallel.
+fn gather_points(
+    points: &[(usize, Vec<(At, DVec3)>)],
+    indirect: &(impl Fn(usize, DVec3) -> ([f64; 3], f64, u64) + Sync),
     values: &mut Values,
 ) {
-    let points = |i: usize, w: &PatchWork| -> Vec<Vec<(At, DVec3)>> {
+    let mut seen = HashSet::new();
+    let mut todo = Vec::new();
+    for (i, list) in points {
+        for &(at, x) in list {
+            if !values.indirect.contains_key(&at) && seen.insert(at) {
+                todo.push((at, *i, x));
+            }
+        }
+    }
+    let got: Vec<_> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
+    for ((at, _, _), (b, var, n)) in todo.into_iter().zip(got) {
+        values.indirect.insert(at, b);
+        values.indirect_var.insert(at, var);
+        values.rays += n;
+    }
+}
+
+/// Gathers the indirect light at the nodes of the roots of every patch that `near` marks
+/// ([`near_patches`]) into `values.indirect` and sets those patches'
+/// [`PatchWork::ind_nodes`] (the others' stay empty): first every root's corners (each distinct
+/// point once, by the lowest-numbered patch that has it; in parallel), then the other nodes
+/// of the patches whose corners' indirect light differs by more than [`SPREAD`] of their
+/// mean. `at(patch, work, root, uv)` says where a point's value is kept and where it is
+/// gathered; `indirect(patch, x)` gathers the indirect light at `x` as that patch, with the
+/// rays it cost.
+pub(super) fn gather(
+    work: &mut [PatchWork],
+    near: &[bool],
+    at: impl Fn(usize, &PatchWork, u32, DVec2) -> (At, DVec3) + Sync,
+    indirect: impl Fn(usize, DVec3) -> ([f64; 3], f64, u64) + Sync,
+    values: &mut Values,
+) {
+    // Per patch, per root: its nodes, the corners only unless `all`.
+    let points = |i: usize, w: &PatchWork, all: bool| -> Vec<Vec<(At, DVec3)>> {
         (w.roots.iter().enumerate())
             .map(|(k, root)| {
                 let e = root.element(k as u32);
-                (nodes(&e).into_iter())
+                let keep = if all { usize::MAX } else { e.count() };
+                (nodes(&e).into_iter().take(keep))
                     .map(|uv| at(i, w, k as u32, uv))
                     .collect()
             })
             .collect()
     };
-    let mut seen = HashSet::new();
-    let mut todo = Vec::new();
-    for (i, w) in work.iter().enumerate() {
-        for (at, x) in points(i, w).into_iter().flatten() {
-            if seen.insert(at) {
-                todo.push((at, i, x));
-            }
-        }
+    let corners: Vec<(usize, Vec<(At, DVec3)>)> = (work.par_iter().enumerate())
+        .filter(|(i, _)| near[*i])
+        .map(|(i, w)| (i, points(i, w, false).concat()))
+        .collect();
+    gather_points(&corners, &indirect, values);
+    let v = &*values;
+    let mut all = vec![false; work.len()];
+    for (i, list) in &corners {
+        let s: Vec<f64> = list.iter().map(|(a, _)| scalar(&v.indirect[a])).collect();
+        let (lo, hi) = (s.iter()).fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+        all[*i] = hi - lo > SPREAD * s.iter().sum::<f64>() / s.len().max(1) as f64;
     }
-    let got: Vec<([f64; 3], u64)> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
-    for ((at, _, _), (b, n)) in todo.into_iter().zip(got) {
-        values.indirect.insert(at, b);
-        values.rays += n;
-    }
+    let rest: Vec<(usize, Vec<(At, DVec3)>)> = (work.par_iter().enumerate())
+        .filter(|(i, _)| all[*i])
+        .map(|(i, w)| (i, points(i, w, true).concat()))
+        .collect();
+    gather_points(&rest, &indirect, values);
     let v = &*values;
     work.par_iter_mut().enumerate().for_each(|(i, w)| {
-        w.ind_nodes = (points(i, w).into_iter())
+        if !near[i] {
+            return;
+        }
+        let pts = points(i, w, all[i]);
+        w.ind_nodes = (pts.iter())
             .map(|root| root.iter().map(|(at, _)| v.indirect[at]).collect())
             .collect();
+        w.ind_var = (pts.iter())
+            .map(|root| root.iter().map(|(at, _)| v.indirect_var[at]).collect())
+            .collect();
     });
+}
+
+/// Hemisphere rays each patch casts from its centre to find how near the geometry it sees is
+/// ([`near_patches`]): a 4 × 4 stratified cosine-weighted set.
+pub const PROBE_SIDE: usize = 4;
+
+/// Which patches gather the indirect light at their nodes, with the rays it cost to tell
+/// (Ward, Rubinstein & Clear, *A ray tracing solution for diffuse interreflection*, SIGGRAPH
+/// 1988, Sec. 2.2): the indirect irradiance at a point changes over a distance d by about
+/// d/R of itself, R the harmonic mean distance of the surfaces the point sees, so across a
+/// patch of size s = √A by about s/R, and what bilinear interpolation between its corners
+/// misses (the curvature) by about (s/R)²/8. A patch where that exceeds `threshold` (the
+/// elements' own, `--element-threshold`) sees geometry near enough to shape its indirect light
+/// (a contact, a wall's edge, under a table) and gathers it at its nodes; the others take
+/// theirs from the patch solution (the final gather's estimate, averaged to the vertices), at
+/// no ray. R is measured from each patch's centre with [`PROBE_SIDE`]² cosine-weighted rays
+/// (a ray that leaves the model counts as infinitely far), drawn from (seed,
+/// [`Stream::Elements`], 2⁶³ + patch).
+pub(super) fn near_patches<I: Intersector>(
+    mesh: &Mesh,
+    light: &LightAt<'_, I>,
+    seed: u64,
+    threshold: f64,
+) -> (Vec<bool>, u64) {
+    let n = PROBE_SIDE * PROBE_SIDE;
+    let got: Vec<(bool, u64)> = (0..mesh.patches.len())
+        .into_par_iter()
+        .map(|i| {
+            let p = &mesh.patches[i];
+            let s = p.area.sqrt();
+            let mut rng = rng_for(seed, Stream::Elements, (1 << 63) | i as u64);
+            let frame = Frame::new(p.normal, rng.gen::<f32>() * std::f32::consts::TAU);
+            let org = p.centre
+                + p.normal
+                    * (1e-4 * s as f32).max(f32::EPSILON * p.centre.abs().max_element() * 16.0);
+            let (mut inv, mut rays) = (0.0f64, 0u64);
+            for k in 0..n {
+                let u1 = ((k / PROBE_SIDE) as f32 + rng.gen::<f32>()) / PROBE_SIDE as f32;
+                let u2 = ((k % PROBE_SIDE) as f32 + rng.gen::<f32>()) / PROBE_SIDE as f32;
+                let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
+                let d = Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt());
+                let seen = light.view(org, frame.to_world(d));
+                rays += seen.rays;
+                if let Some(h) = seen.hit {
+                    inv += 1.0 / (h.point - org).length().max(f32::MIN_POSITIVE) as f64;
+                }
+            }
+            let ratio = s * inv / n as f64;
+            (ratio * ratio / 8.0 > threshold, rays)
+        })
+        .collect();
+    let rays = got.iter().map(|g| g.1).sum();
+    (got.into_iter().map(|g| g.0).collect(), rays)
 }
 
 #[cfg(test)]

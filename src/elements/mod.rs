@@ -45,17 +45,20 @@ pub use refine::{CornerLight, Rule, Stop, Test};
 pub const DEFAULT_THRESHOLD: f64 = 0.02;
 /// Default smallest element, as a fraction of the patch size.
 pub const DEFAULT_MIN_FRACTION: f32 = 1.0 / 8.0;
-/// Default `--element-rays`: rays of each corner's gather (at 128 the corners' own noise,
-/// about 1.1 % on `scenes/spot.obj`, is a floor the meshing cannot go under: 0.53 of uniform
-/// meshing's error at the same count, 0.47 at 256; at 64 it shows as faint blotches).
-pub const DEFAULT_RAYS: usize = 256;
+/// Default `--element-rays`: with the default [`CornerLight::Split`], the rays of each
+/// indirect node's gather, 3/8 as many for each corner's direct light. With the patches
+/// setting the level (`display`'s notes) 64 reach about the error [`CornerLight::Full`] had
+/// at 256 on `scenes/spot.obj` (docs/results/adaptive-elements.md); [`CornerLight::Full`]
+/// wants 256 (at 128 the corners' own noise is a floor the meshing cannot go under).
+pub const DEFAULT_RAYS: usize = 64;
 /// Default cap on the elements, as a multiple of the patches.
 pub const DEFAULT_MAX_FACTOR: f64 = 8.0;
 /// `--elements auto` (the default) refines the elements of meshes up to this many patches
-/// and skips them, with a line, above: their cost grows with the patches, about 1.1–1.3 ms a
-/// patch on 2 cores (6.0 s for the 5,267-patch church; 28.6 s for the furnished office's
-/// 21,801 patches, whose solve takes 20 s), so a big model's picture is the final gather's.
-pub const AUTO_MAX_PATCHES: u64 = 10_000;
+/// and skips them, with a line, above: with the split corners on the patches that see
+/// geometry nearby their rays stay under the solve's (the office 0.98, the furnished office
+/// 0.27, a generated 100 k-patch building 0.63 of the solve's and final gather's rays;
+/// docs/results/adaptive-elements.md), but their elements' memory grows with the model.
+pub const AUTO_MAX_PATCHES: u64 = 1_000_000;
 /// Below this fraction of the scene's mean radiosity, differences count as if at it (dark
 /// corners are not refined for noise).
 pub const FLOOR: f64 = 1e-3;
@@ -95,7 +98,7 @@ impl Default for ElementSettings {
             rays: DEFAULT_RAYS,
             max_factor: DEFAULT_MAX_FACTOR,
             test: Test::Halves,
-            light: CornerLight::Full,
+            light: CornerLight::Split,
         }
     }
 }
@@ -152,8 +155,8 @@ pub struct ElementStats {
     pub patches: u64,
     /// Welded element vertices.
     pub vertices: u64,
-    /// Points gathered: the corners and the points the test reads (a point inside a surface
-    /// once for all its patches, a point on a room's edge by each patch that has it).
+    /// Points gathered: the corners and the points the test reads, each once for all the
+    /// patches that have it (and, split, the indirect light's nodes).
     pub gathered: u64,
     /// Rays cast by the corners' gathers.
     pub rays: u64,
@@ -166,6 +169,10 @@ pub struct ElementStats {
     pub rays_per_corner: u64,
     /// Whether the cap on the elements stopped the refinement.
     pub capped: bool,
+    /// `--element-light split`: the patches that gathered their indirect light at nodes (the
+    /// others' is the patch solution's).
+    #[serde(default)]
+    pub indirect_patches: u64,
     /// Whether Ctrl-C stopped it (the elements refined by then are kept).
     #[serde(default)]
     pub interrupted: bool,
@@ -353,27 +360,40 @@ pub fn refine_by<I: Intersector>(
         |(l, h), v| (l.min(*v), h.max(*v)),
     );
     let diagonal = (hi - lo).length().max(f32::MIN_POSITIVE) as f64;
+    let threshold = match rule {
+        Rule::Adaptive { threshold, .. } => threshold,
+        Rule::Uniform(_) => DEFAULT_THRESHOLD,
+    };
+    // Split: which patches see geometry near enough to gather their indirect light at nodes.
+    let (near, probe_rays) = match light {
+        CornerLight::Split => indirect::near_patches(mesh, gather, seed, threshold),
+        _ => (Vec::new(), 0),
+    };
+    let indirect_patches = near.iter().filter(|&&n| n).count() as u64;
     let r = refine::Refiner {
         mesh,
         gather,
         b,
         seed,
-        // Split: a quarter of the rays to each corner's direct light, all of them to each
-        // node of the indirect light (README, "Adaptive elements").
+        // Split: 3/8 of the rays to each corner's direct light, all of them to each node of
+        // the indirect light (docs/results/adaptive-elements.md: a quarter, 16 at the default,
+        // left a stretch of spot.obj's table shadow unrefined; half cost the office 1.3 times
+        // the rays).
         rays: if light == CornerLight::Split {
-            (rays / 4).max(2)
+            (rays * 3 / 8).max(2)
         } else {
             rays
         },
         light,
         indirect_rays: rays,
+        near,
         quantum: diagonal * 1e-6,
         inner: refine::inner_edges(mesh),
         stop,
     };
     let (work, values, capped) = refine::run(&r, rule, cap.max(mesh.patches.len()));
     let gathered = values.map.len() + values.indirect.len();
-    let built = display::build(&r, work, values.rays);
+    let built = display::build(&r, work, values.rays + probe_rays);
     let vertex_b: Vec<[f32; 3]> = built.vertex_b.iter().map(|v| v.map(|x| x as f32)).collect();
     let mut el = Elements::new(built.mesh, built.patch, vertex_b);
     el.params = built.elems;
@@ -388,6 +408,7 @@ pub fn refine_by<I: Intersector>(
         min_size: 0.0,
         rays_per_corner: rays as u64,
         capped,
+        indirect_patches,
         interrupted: stop.interrupted(),
         out_of_time: stop.out_of_time(),
     };

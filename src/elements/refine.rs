@@ -3,8 +3,8 @@
 //! in four, level by level, until none is, or they reach the minimum size.
 //!
 //! **Values at the corners.** Cohen 1986 computes the radiosity at element vertices by
-//! hemi-cubes placed there, with the patches as the light's sources. Here each corner gathers
-//! the whole light ([`CornerLight::Full`], the default; [`LightAt::radiosity_at`]): the
+//! hemi-cubes placed there, with the patches as the light's sources. Here each corner may gather
+//! the whole light ([`CornerLight::Full`]; [`LightAt::radiosity_at`]): the
 //! emitters and the sun by shadow rays at the point, the rest over the hemisphere, with the
 //! patch solution as the cache of the indirect light. [`CornerLight::Direct`] gathers only
 //! the direct light there ([`LightAt::part_at`]: the part with the shadow edges and the peaks
@@ -14,17 +14,21 @@
 //! rays, but the indirect light's own variation within a patch (contact shadows, under a
 //! table) is then neither seen by the test nor shown: on `scenes/spot.obj` it leaves a floor
 //! of 1.6 % under every mesh's error, where the full gather's is under 1 %.
-//! [`CornerLight::Split`] gathers the direct light at every point too, and the indirect part
-//! at nine nodes of each patch, interpolated quadratically beneath (`elements/indirect.rs`): the
-//! contact shadows' fall-off is seen at the patch's scale, for about a third of the full
-//! gather's rays.
+//! [`CornerLight::Split`] (the default) gathers the direct light at every point too, and the
+//! indirect part only on the patches that see geometry near enough to shape it (Ward's
+//! split-sphere criterion, `elements/indirect.rs`), at their corners and, where those differ,
+//! at nine nodes, interpolated beneath: the contact shadows' fall-off is seen at the patch's
+//! scale; every other patch's indirect light is the patch solution's, as under
+//! [`CornerLight::Direct`].
 //!
 //! **Shared points.** A point that no patch boundary of its surface runs through — inside a
 //! patch, or on an edge two patches share — has one value for every patch that has it,
 //! gathered once (by the lowest-numbered patch that asks). A point on a patch's edge that no
-//! neighbour shares (a room's edge, where the floor meets a wall) is each patch's own, and is
-//! gathered at a point moved [`INSET`] of the way towards its patch's centre, so that a corner
-//! in a room's edge does not cast its rays from inside the wall beside it.
+//! neighbour of its surface shares (a room's edge, where the floor meets a wall) is gathered
+//! at a point moved [`INSET`] of the way towards the asking patch's centre, so that a corner
+//! in a room's edge does not cast its rays from inside the wall beside it; it too is kept by
+//! position, facing and material, once for the patches along that edge that have it (the
+//! display welds them into one vertex anyway, and the insets differ by 0.2 % of a patch).
 //!
 //! **Common random numbers.** Every point of one scene polygon is gathered with a generator
 //! seeded alike, from (seed, [`Stream::Elements`], polygon): neighbouring corners then use the
@@ -38,7 +42,8 @@
 //! on the thread count.
 
 use super::geometry::{Cut, Elem, Root};
-pub(super) use super::work::{At, PatchWork, Values};
+use super::work::on_edges;
+pub(super) use super::work::{facing, inner_edges, key, At, PatchWork, Values};
 use crate::intersect::Intersector;
 use crate::light::{LightAt, LightParts};
 use crate::mesh::Mesh;
@@ -72,13 +77,16 @@ pub enum CornerLight {
     #[value(help = crate::settings::NO_HELP)]
     Direct,
     /// The whole gather at every corner (direct and hemisphere rays).
-    #[default]
     #[value(help = crate::settings::NO_HELP)]
     Full,
-    /// The direct light at every corner (a quarter of `--element-rays`); the indirect light
-    /// gathered (with all of them) at nine nodes of each patch, shared with its neighbours, and
-    /// interpolated quadratically across its elements. About a third of
-    /// [`CornerLight::Full`]'s rays on the office, a little more error.
+    /// The direct light at every corner (3/8 of `--element-rays`); the indirect light,
+    /// on the patches that see geometry near enough to shape it (`indirect::near_patches`),
+    /// gathered (with all of them) at each patch's corners, shared with its neighbours, and
+    /// where they differ at its edge midpoints and centre too, interpolated across its
+    /// elements (bilinearly, or quadratically through the nine); on the others, the patch
+    /// solution's, as [`CornerLight::Direct`] takes it. The default: at 64 rays, 0.07 of
+    /// [`CornerLight::Full`]'s rays at 256 on the office (docs/results/adaptive-elements.md).
+    #[default]
     #[value(help = crate::settings::NO_HELP)]
     Split,
 }
@@ -131,13 +139,18 @@ pub enum Rule {
 pub(super) struct Refiner<'a, I> {
     pub mesh: &'a Mesh,
     pub gather: &'a LightAt<'a, I>,
-    /// The patch solution the indirect light of [`CornerLight::Direct`] is taken from.
+    /// The patch solution: the level of every patch's elements (`display`'s notes, "Level"),
+    /// and the indirect light of [`CornerLight::Direct`].
     pub b: &'a [[f64; 3]],
     pub seed: u64,
     pub rays: usize,
     pub light: CornerLight,
     /// [`CornerLight::Split`]: rays of each patch corner's indirect gather.
     pub indirect_rays: usize,
+    /// [`CornerLight::Split`]: per patch, whether it gathers the indirect light at its nodes
+    /// (`indirect::near_patches`); the others', and every patch's under
+    /// [`CornerLight::Direct`], is interpolated from the patch solution.
+    pub near: Vec<bool>,
     pub quantum: f64,
     /// Per patch, bit k set: its edge k (corner k to k + 1) is shared with a neighbour
     /// ([`inner_edges`]).
@@ -168,69 +181,6 @@ impl Stop<'_> {
     }
 }
 
-/// The cache key of a position.
-pub(super) fn key(p: DVec3, quantum: f64) -> [i64; 3] {
-    let q = |x: f64| (x / quantum).round() as i64;
-    [q(p.x), q(p.y), q(p.z)]
-}
-
-/// A facing, quantised as the mesh welds vertices.
-pub(super) fn facing(n: Vec3) -> [i32; 3] {
-    let qn = |x: f32| (x * 1000.0).round() as i32;
-    [qn(n.x), qn(n.y), qn(n.z)]
-}
-
-/// Per patch, which of its edges another patch shares (bit k: corner k to k + 1; the mesh's
-/// vertices are welded by position, facing and material, so a neighbour on the same surface
-/// runs the edge the other way). Edges past the 64th are never marked shared.
-pub(super) fn inner_edges(mesh: &Mesh) -> Vec<u64> {
-    let ring = |i: usize| {
-        let ids = mesh.patch_indices(i);
-        (0..ids.len()).map(move |k| (ids[k], ids[(k + 1) % ids.len()]))
-    };
-    let edges: HashSet<(u32, u32)> = (0..mesh.patches.len()).flat_map(ring).collect();
-    (0..mesh.patches.len())
-        .map(|i| {
-            ring(i)
-                .take(64)
-                .enumerate()
-                .filter(|&(_, (a, b))| a != b && edges.contains(&(b, a)))
-                .fold(0u64, |m, (k, _)| m | 1 << k)
-        })
-        .collect()
-}
-
-/// The edges of an `n`-cornered patch that the point `uv` of root `root` lies on (bit k: edge
-/// k), `None` when one of them is past the 64th. A quad root's edges are v = 0, u = 1, v = 1,
-/// u = 0; fan triangle `root` has corners 0, root + 1, root + 2, of which only its far side
-/// and the fan's first and last sides are the patch's edges. The parameters are dyadic, so
-/// the tests are exact.
-fn on_edges(n: usize, root: usize, tri: bool, uv: DVec2) -> Option<u64> {
-    let (u, v) = (uv.x, uv.y);
-    let mut edges: Vec<usize> = Vec::new();
-    if !tri {
-        for (on, k) in [(v == 0.0, 0), (u == 1.0, 1), (v == 1.0, 2), (u == 0.0, 3)] {
-            if on {
-                edges.push(k);
-            }
-        }
-    } else {
-        let k = root + 1;
-        if v == 0.0 && k == 1 {
-            edges.push(0);
-        }
-        if u + v == 1.0 {
-            edges.push(k);
-        }
-        if u == 0.0 && k + 2 == n {
-            edges.push(n - 1);
-        }
-    }
-    edges
-        .iter()
-        .try_fold(0u64, |m, &k| (k < 64).then(|| m | 1 << k))
-}
-
 /// The points a decision on `e` reads: its corners and, unless the test is on the corners
 /// alone, the points a cut would add (edge midpoints, a quad's centre).
 fn test_points(e: &Elem, test: Test) -> Vec<DVec2> {
@@ -255,6 +205,17 @@ struct Deviation {
 }
 
 impl<I: Intersector> Refiner<'_, I> {
+    /// Whether patch `patch`'s points hold its indirect light (gathered at its nodes, or in
+    /// the whole gather): otherwise their values are the direct light, and the indirect is
+    /// added from the patch solution when the refinement ends ([`finish`]).
+    fn gathers_indirect(&self, patch: usize) -> bool {
+        match self.light {
+            CornerLight::Full => true,
+            CornerLight::Direct => false,
+            CornerLight::Split => self.near[patch],
+        }
+    }
+
     /// Whether Ctrl-C or the deadline asks to stop.
     pub fn stopped(&self) -> bool {
         self.stop.interrupted() || self.stop.out_of_time()
@@ -268,13 +229,14 @@ impl<I: Intersector> Refiner<'_, I> {
         let k = key(p, self.quantum);
         let pt = &self.mesh.patches[patch];
         let n = pt.count as usize;
+        let at = At(k, facing(pt.normal), pt.material);
         let shared =
             on_edges(n, root as usize, r.tri, uv).is_some_and(|m| m & !self.inner[patch] == 0);
         if shared {
-            (At::Shared(k, facing(pt.normal), pt.material), p)
+            (at, p)
         } else {
             let c = pt.centre.as_dvec3();
-            (At::Own(patch as u32, k), p + (c - p) * INSET)
+            (at, p + (c - p) * INSET)
         }
     }
 
@@ -282,15 +244,26 @@ impl<I: Intersector> Refiner<'_, I> {
     fn value(&self, patch: usize, w: &PatchWork, root: u32, uv: DVec2, v: &Values) -> [f64; 3] {
         let (at, _) = self.at(patch, w, root, uv);
         let b = v.map.get(&at).copied().unwrap_or([0.0; 3]);
-        if self.light != CornerLight::Split {
+        // Split corners' gathered indirect light is at the nodes; Full's is in `b`.
+        if self.light != CornerLight::Split || !self.near[patch] {
             return b;
         }
         let ind = super::indirect::at(&w.ind_nodes[root as usize], uv);
         [0, 1, 2].map(|c| b[c] + ind[c])
     }
 
+    /// The variance of the indirect light [`Refiner::value`] interpolates at the same point
+    /// from its patch's nodes (Σ wₖ² σₖ²; [`CornerLight::Split`] on the patches that gather
+    /// nodes, else 0).
+    fn variance(&self, patch: usize, w: &PatchWork, root: u32, uv: DVec2) -> f64 {
+        if self.light != CornerLight::Split || !self.near[patch] {
+            return 0.0;
+        }
+        super::indirect::var_at(&w.ind_var[root as usize], uv)
+    }
+
     /// Gathers at `x`, as patch `patch` (module notes): the direct light, or all of it.
-    fn gather_one(&self, patch: usize, x: DVec3) -> ([f64; 3], u64) {
+    fn gather_one(&self, patch: usize, x: DVec3) -> ([f64; 3], f64, u64) {
         match self.light {
             CornerLight::Full => self.gather_part(patch, x, LightParts::All, self.rays),
             CornerLight::Direct | CornerLight::Split => {
@@ -306,15 +279,15 @@ impl<I: Intersector> Refiner<'_, I> {
         x: DVec3,
         parts: LightParts,
         rays: usize,
-    ) -> ([f64; 3], u64) {
+    ) -> ([f64; 3], f64, u64) {
         let polygon = self.mesh.patches[patch].polygon as u64;
         let mut rng = rng_for(self.seed, Stream::Elements, polygon);
         let pts = [x.as_vec3()];
-        let (b, _, rays) = self.gather.part_at(patch, &pts, rays, parts, &mut rng);
+        let (b, var, rays) = self.gather.part_at(patch, &pts, rays, parts, &mut rng);
         let b = b
             .to_array()
             .map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
-        (b, rays)
+        (b, var, rays)
     }
 
     /// Gathers the points `want` lists (per patch: the points' parameters, by root) that
@@ -331,11 +304,11 @@ impl<I: Intersector> Refiner<'_, I> {
                 }
             }
         }
-        let got: Vec<([f64; 3], u64)> = todo
+        let got: Vec<([f64; 3], f64, u64)> = todo
             .par_iter()
             .map(|&(_, i, x)| self.gather_one(i, x))
             .collect();
-        for ((at, _, _), (b, rays)) in todo.into_iter().zip(got) {
+        for ((at, _, _), (b, _, rays)) in todo.into_iter().zip(got) {
             values.map.insert(at, b);
             values.rays += rays;
         }
@@ -401,6 +374,20 @@ impl<I: Intersector> Refiner<'_, I> {
             halves: Some((left_u, left_v)),
             mean,
         }
+    }
+
+    /// The variance the interpolated indirect light's noise puts in the difference `test`
+    /// measures on `e`: the largest variance among the points it reads, times 2 (two corners'
+    /// difference) or 1.5 (a midpoint against its edge's two corners). The direct light's
+    /// noise is left out: every point of a polygon draws the same light samples and
+    /// directions, so its differences are the light's (a shadow's penumbra, whose points are
+    /// each noisy, is still refined), where the few nodes of the indirect light are
+    /// interpolated and their noise would show as curvature.
+    fn test_noise(&self, patch: usize, e: &Elem, w: &PatchWork, test: Test) -> f64 {
+        let worst = (test_points(e, test).into_iter())
+            .map(|uv| self.variance(patch, w, e.root, uv))
+            .fold(0.0f64, f64::max);
+        worst * if test == Test::Corners { 2.0 } else { 1.5 }
     }
 
     /// One level of patch `patch`: the active elements that `rule` would cut, with their
@@ -493,10 +480,14 @@ impl<I: Intersector> Refiner<'_, I> {
         // The direct light's differences against the whole light there: the root's first
         // test gives its indirect part (the patch's radiosity less the direct light's mean).
         let r = e.root as usize;
-        if self.light == CornerLight::Direct && e.depth == 0 {
+        if !self.gathers_indirect(patch) && e.depth == 0 {
             w.indirect[r] = (scalar(&self.b[patch]) - mean).max(0.0);
         }
         let whole = corners_mean + w.indirect[r];
+        // The difference less the noise the indirect nodes put in it (in quadrature).
+        let d = (d * d - NOISE_Z * NOISE_Z * self.test_noise(patch, e, w, test))
+            .max(0.0)
+            .sqrt();
         let mut contrast = d / whole.max(floor).max(f64::MIN_POSITIVE);
         if test != Test::Corners {
             // Weighed by the element's share of its root's area (4^−depth after cuts in four):
@@ -506,6 +497,17 @@ impl<I: Intersector> Refiner<'_, I> {
         (contrast > threshold).then_some((contrast, how))
     }
 }
+
+/// The test takes this many standard deviations of the indirect nodes' noise
+/// ([`Refiner::test_noise`]) off a difference (in quadrature: √(d² − z²σ²)) before it weighs
+/// it against the threshold: in a uniformly lit room the differences are that noise alone,
+/// and a threshold on the light cannot tell them from a shadow's. Measured on a closed box
+/// whose every patch emits (the furnace test; seeds 1–20, split corners at 64 rays): 8
+/// elements cut in all with nothing taken off, 2 with one σ, none with 1.5, 2 or 3; on
+/// `bench elements scenes/spot.obj --tests halves` at 0.02: 1.19 % error with nothing taken
+/// off, 1.22 % with 1.5, 1.23 % with 2 (ratio 0.49 to uniform meshing). A bare cut-off (cut
+/// only above 3σ) left one cut in the 20 and 1.27 % (docs/results/adaptive-elements.md).
+pub(super) const NOISE_Z: f64 = 2.0;
 
 /// Whether `e` is at least twice the smallest element edge along its longer side.
 fn big_enough(e: &Elem, w: &PatchWork, min_size: f64) -> bool {
@@ -541,9 +543,10 @@ fn interpolate(at: &[[f32; 3]], root: usize, tri: bool, uv: DVec2) -> [f64; 3] {
 }
 
 /// Gathers the kept elements' corners and sets every patch's [`PatchWork::corner_b`]: the
-/// gathered values, plus, for [`CornerLight::Direct`], the indirect light interpolated from
-/// the patches' (their radiosity less the mean of their elements' direct light, averaged to
-/// the welded vertices).
+/// gathered values, plus, where they are the direct light alone ([`CornerLight::Direct`], and
+/// the patches of [`CornerLight::Split`] that gather no indirect nodes), the indirect light
+/// interpolated from the patches' (their radiosity less the mean of their elements' direct
+/// light, averaged to the welded vertices).
 pub(super) fn finish<I: Intersector>(
     r: &Refiner<'_, I>,
     work: &mut [PatchWork],
@@ -558,53 +561,61 @@ pub(super) fn finish<I: Intersector>(
         .collect();
     r.gather_all(work, &want, values);
     let v = &*values;
+    // Per patch, its kept corners' direct light (what `values.map` holds).
     let direct: Vec<Vec<[f64; 3]>> = (work.par_iter().enumerate())
         .map(|(i, w)| {
             (w.done.iter())
                 .flat_map(|e| {
-                    e.corners_uv()
-                        .iter()
-                        .map(move |&uv| r.value(i, w, e.root, uv, v))
+                    e.corners_uv().iter().map(move |&uv| {
+                        let (at, _) = r.at(i, w, e.root, uv);
+                        v.map.get(&at).copied().unwrap_or([0.0; 3])
+                    })
                 })
                 .collect()
         })
         .collect();
-    let indirect: Vec<[f32; 3]> = match r.light {
-        CornerLight::Full | CornerLight::Split => Vec::new(),
-        CornerLight::Direct => {
-            let own: Vec<[f64; 3]> = (work.iter().zip(&direct).enumerate())
-                .map(|(i, (w, d))| {
-                    let (mut s, mut a) = ([0.0f64; 3], 0.0);
-                    let mut k = 0;
-                    for e in &w.done {
-                        let n = e.count();
-                        let ae = e.share() * root_area(&w.roots[e.root as usize]);
-                        for dv in &d[k..k + n] {
-                            for c in 0..3 {
-                                s[c] += ae * dv[c] / n as f64;
-                            }
+    let indirect: Vec<[f32; 3]> = if (0..work.len()).all(|i| r.gathers_indirect(i)) {
+        Vec::new()
+    } else {
+        let own: Vec<[f64; 3]> = (work.iter().zip(&direct).enumerate())
+            .map(|(i, (w, d))| {
+                let (mut s, mut a) = ([0.0f64; 3], 0.0);
+                let mut k = 0;
+                for e in &w.done {
+                    let n = e.count();
+                    let ae = e.share() * root_area(&w.roots[e.root as usize]);
+                    for dv in &d[k..k + n] {
+                        for c in 0..3 {
+                            s[c] += ae * dv[c] / n as f64;
                         }
-                        a += ae;
-                        k += n;
                     }
-                    let mean = s.map(|x| if a > 0.0 { x / a } else { 0.0 });
-                    [0, 1, 2].map(|c| r.b[i][c] - mean[c])
-                })
-                .collect();
-            r.mesh.vertex_values(&own)
-        }
+                    a += ae;
+                    k += n;
+                }
+                let mean = s.map(|x| if a > 0.0 { x / a } else { 0.0 });
+                [0, 1, 2].map(|c| r.b[i][c] - mean[c])
+            })
+            .collect();
+        r.mesh.vertex_values(&own)
     };
     work.par_iter_mut()
         .zip(direct)
         .enumerate()
         .for_each(|(i, (w, d))| {
+            if r.gathers_indirect(i) {
+                w.corner_b = (w.done.iter())
+                    .flat_map(|e| {
+                        e.corners_uv()
+                            .iter()
+                            .map(|&uv| r.value(i, w, e.root, uv, v))
+                    })
+                    .collect();
+                return;
+            }
             w.corner_b = d;
-            let at: Vec<[f32; 3]> = match r.light {
-                CornerLight::Full | CornerLight::Split => return,
-                CornerLight::Direct => (r.mesh.patch_indices(i).iter())
-                    .map(|&k| indirect[k as usize])
-                    .collect(),
-            };
+            let at: Vec<[f32; 3]> = (r.mesh.patch_indices(i).iter())
+                .map(|&k| indirect[k as usize])
+                .collect();
             let mut k = 0;
             for e in &w.done {
                 let tri = w.roots[e.root as usize].tri;
@@ -650,6 +661,7 @@ pub(super) fn run<I: Intersector>(
                 done: Vec::new(),
                 corner_b: Vec::new(),
                 ind_nodes: Vec::new(),
+                ind_var: Vec::new(),
             }
         })
         .collect();
@@ -657,6 +669,7 @@ pub(super) fn run<I: Intersector>(
     if r.light == CornerLight::Split {
         super::indirect::gather(
             &mut work,
+            &r.near,
             |i, w, root, uv| r.at(i, w, root, uv),
             |i, x| r.gather_part(i, x, LightParts::Indirect, r.indirect_rays),
             &mut values,

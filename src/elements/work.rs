@@ -1,20 +1,18 @@
-//! The state the refinement keeps while it runs: where each gathered value is kept ([`At`]),
-//! the values gathered so far ([`Values`]) and each patch's elements ([`PatchWork`]). Types
-//! only, shared by the refinement loop ([`super::refine`]) and the indirect light's nodes
-//! ([`super::indirect`]).
+//! The state the refinement keeps while it runs: where each gathered value is kept ([`At`]:
+//! the keys of position and facing, and which of a patch's edges a neighbour shares), the
+//! values gathered so far ([`Values`]) and each patch's elements ([`PatchWork`]); shared by the
+//! refinement loop ([`super::refine`]), the indirect light's nodes ([`super::indirect`]) and
+//! the display ([`super::display`]).
 
 use super::geometry::{Elem, Root};
-use std::collections::HashMap;
+use crate::mesh::Mesh;
+use glam::{DVec2, DVec3, Vec3};
+use std::collections::{HashMap, HashSet};
 
-/// Where a point's value is kept ([`super::refine`]'s notes, "Shared points").
+/// Where a point's value is kept ([`super::refine`]'s notes, "Shared points"): its position,
+/// facing and material, as the mesh welds its vertices.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub(super) enum At {
-    /// A point of a surface no patch boundary runs through: position, facing, material (as
-    /// the mesh welds its vertices).
-    Shared([i64; 3], [i32; 3], u32),
-    /// A point on an edge of this patch that no neighbour shares.
-    Own(u32, [i64; 3]),
-}
+pub(super) struct At(pub [i64; 3], pub [i32; 3], pub u32);
 
 /// The values gathered so far, and the rays they cost.
 #[derive(Default)]
@@ -22,6 +20,9 @@ pub(super) struct Values {
     pub map: HashMap<At, [f64; 3]>,
     /// [`super::CornerLight::Split`]: the indirect light at the patches' corners.
     pub indirect: HashMap<At, [f64; 3]>,
+    /// The variance of each of `indirect`'s values (scalar; the gather's own, from its
+    /// strata): what the refinement's test takes for noise.
+    pub indirect_var: HashMap<At, f64>,
     pub rays: u64,
 }
 
@@ -40,4 +41,69 @@ pub(super) struct PatchWork {
     /// [`super::CornerLight::Split`]: per root, the indirect light at its quadratic's nodes
     /// ([`super::indirect`]).
     pub ind_nodes: Vec<Vec<[f64; 3]>>,
+    /// The variance of each of `ind_nodes`' values.
+    pub ind_var: Vec<Vec<f64>>,
+}
+
+/// The cache key of a position.
+pub(super) fn key(p: DVec3, quantum: f64) -> [i64; 3] {
+    let q = |x: f64| (x / quantum).round() as i64;
+    [q(p.x), q(p.y), q(p.z)]
+}
+
+/// A facing, quantised as the mesh welds vertices.
+pub(super) fn facing(n: Vec3) -> [i32; 3] {
+    let qn = |x: f32| (x * 1000.0).round() as i32;
+    [qn(n.x), qn(n.y), qn(n.z)]
+}
+
+/// Per patch, which of its edges another patch shares (bit k: corner k to k + 1; the mesh's
+/// vertices are welded by position, facing and material, so a neighbour on the same surface
+/// runs the edge the other way). Edges past the 64th are never marked shared.
+pub(super) fn inner_edges(mesh: &Mesh) -> Vec<u64> {
+    let ring = |i: usize| {
+        let ids = mesh.patch_indices(i);
+        (0..ids.len()).map(move |k| (ids[k], ids[(k + 1) % ids.len()]))
+    };
+    let edges: HashSet<(u32, u32)> = (0..mesh.patches.len()).flat_map(ring).collect();
+    (0..mesh.patches.len())
+        .map(|i| {
+            ring(i)
+                .take(64)
+                .enumerate()
+                .filter(|&(_, (a, b))| a != b && edges.contains(&(b, a)))
+                .fold(0u64, |m, (k, _)| m | 1 << k)
+        })
+        .collect()
+}
+
+/// The edges of an `n`-cornered patch that the point `uv` of root `root` lies on (bit k: edge
+/// k), `None` when one of them is past the 64th. A quad root's edges are v = 0, u = 1, v = 1,
+/// u = 0; fan triangle `root` has corners 0, root + 1, root + 2, of which only its far side
+/// and the fan's first and last sides are the patch's edges. The parameters are dyadic, so
+/// the tests are exact.
+pub(super) fn on_edges(n: usize, root: usize, tri: bool, uv: DVec2) -> Option<u64> {
+    let (u, v) = (uv.x, uv.y);
+    let mut edges: Vec<usize> = Vec::new();
+    if !tri {
+        for (on, k) in [(v == 0.0, 0), (u == 1.0, 1), (v == 1.0, 2), (u == 0.0, 3)] {
+            if on {
+                edges.push(k);
+            }
+        }
+    } else {
+        let k = root + 1;
+        if v == 0.0 && k == 1 {
+            edges.push(0);
+        }
+        if u + v == 1.0 {
+            edges.push(k);
+        }
+        if u == 0.0 && k + 2 == n {
+            edges.push(n - 1);
+        }
+    }
+    edges
+        .iter()
+        .try_fold(0u64, |m, &k| (k < 64).then(|| m | 1 << k))
 }

@@ -74,7 +74,7 @@ pub struct SolveArgs {
 pub struct ElementArgs {
     /// After the solve, cut each patch into elements where its light changes (shadow edges,
     /// corners, beside lights), each corner's radiosity gathered with rays; the picture,
-    /// the exports and elements.csv use them. auto: on for meshes of up to 10,000 patches;
+    /// the exports and elements.csv use them. auto: on for meshes of up to 1,000,000 patches;
     /// off: the elements are the patches.
     #[arg(long, value_enum, default_value_t = ElementsArg::Auto, value_name = "auto|on|off")]
     elements: ElementsArg,
@@ -87,7 +87,8 @@ pub struct ElementArgs {
     /// The smallest element edge, metres [default: the patch size / 8].
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     element_min_size: Option<f32>,
-    /// Rays of each element corner's gather.
+    /// Rays of each element corner's gather (split: of each indirect node's, 3/8 as many
+    /// for each corner's direct light; full wants 256).
     #[arg(long, value_name = "N", default_value_t = elements::DEFAULT_RAYS)]
     element_rays: usize,
     /// At most this many elements per patch in all (the largest differences are cut first).
@@ -100,12 +101,14 @@ pub struct ElementArgs {
     /// between its corners, cut in four).
     #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().test)]
     element_test: elements::Test,
-    /// What each corner gathers: full (the whole light, direct and hemisphere rays) or
-    /// direct (the emitters' and the sun's light by shadow rays; the indirect light
-    /// interpolated from the patch solution: about a quarter of the rays, a preview that
-    /// misses the indirect light's contact shadows) or split (the direct light at every
-    /// corner, the indirect light gathered at nine nodes of each patch and interpolated
-    /// quadratically: about a third of full's rays, a little more error).
+    /// What each corner gathers: split (the direct light at every corner; the indirect
+    /// light, on the patches that see geometry nearby, gathered at their corners, and at their
+    /// edge midpoints and centre where those differ, interpolated beneath, elsewhere the patch
+    /// solution's), full (the whole light, direct and hemisphere
+    /// rays, at every corner: about 14× split's rays at 256) or direct (the emitters' and the
+    /// sun's light by shadow rays; the indirect light interpolated from the patch solution: a
+    /// preview that misses the indirect light's contact shadows). Every patch's elements are
+    /// scaled to its solved radiosity on average.
     #[arg(long, value_enum, default_value_t = elements::ElementSettings::default().light)]
     element_light: elements::CornerLight,
 }
