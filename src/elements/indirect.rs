@@ -150,6 +150,7 @@ fn gather_points(
         values.indirect.insert(at, b);
         values.indirect_var.insert(at, var);
         values.rays += n;
+        values.gathered += 1;
     }
 }
 
@@ -210,6 +211,9 @@ pub(super) fn gather(
             .map(|root| root.iter().map(|(at, _)| v.indirect_var[at]).collect())
             .collect();
     });
+    // Each patch holds its nodes' values now; the maps only served to gather each point once.
+    values.indirect = Default::default();
+    values.indirect_var = Default::default();
 }
 
 /// Hemisphere rays each patch casts from its centre to find how near the geometry it sees is

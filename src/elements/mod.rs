@@ -392,7 +392,7 @@ pub fn refine_by<I: Intersector>(
         stop,
     };
     let (work, values, capped) = refine::run(&r, rule, cap.max(mesh.patches.len()));
-    let gathered = values.map.len() + values.indirect.len();
+    let gathered = values.gathered;
     let built = display::build(&r, work, values.rays + probe_rays);
     let vertex_b: Vec<[f32; 3]> = built.vertex_b.iter().map(|v| v.map(|x| x as f32)).collect();
     let mut el = Elements::new(built.mesh, built.patch, vertex_b);
@@ -401,7 +401,7 @@ pub fn refine_by<I: Intersector>(
         count: el.mesh.patches.len() as u64,
         patches: mesh.patches.len() as u64,
         vertices: el.mesh.vertices.len() as u64,
-        gathered: gathered as u64,
+        gathered,
         rays: built.rays,
         seconds: t.elapsed().as_secs_f64(),
         threshold: 0.0,

@@ -311,6 +311,23 @@ impl<I: Intersector> Refiner<'_, I> {
         for ((at, _, _), (b, _, rays)) in todo.into_iter().zip(got) {
             values.map.insert(at, b);
             values.rays += rays;
+            values.gathered += 1;
+        }
+    }
+
+    /// Forgets the centres of the quads kept so far (their tests read them): a kept element
+    /// is never cut again, and nothing else of its patch lies inside it, so no decision and no
+    /// corner reads them again. (A patch that lies on another — a doubled face of the same
+    /// facing and material — would gather such a point again itself.)
+    fn forget_centres(&self, work: &[PatchWork], values: &mut Values) {
+        let gone: Vec<At> = (work.par_iter().enumerate())
+            .flat_map_iter(|(i, w)| {
+                (w.done.iter().filter(|e| !e.tri))
+                    .map(move |e| self.at(i, w, e.root, e.centre_uv()).0)
+            })
+            .collect();
+        for at in &gone {
+            values.map.remove(at);
         }
     }
 
@@ -738,6 +755,7 @@ pub(super) fn run<I: Intersector>(
                 w.active.extend(e.cut(how));
             }
         }
+        r.forget_centres(&work, &mut values);
         if capped {
             // Whatever is still active after the cap is kept as it is.
             for w in &mut work {
@@ -748,5 +766,13 @@ pub(super) fn run<I: Intersector>(
         }
     }
     finish(r, &mut work, &mut values);
+    // The display reads each patch's roots, kept elements and their corners' values only.
+    for w in &mut work {
+        w.active = Vec::new();
+        w.indirect = Vec::new();
+        w.ind_nodes = Vec::new();
+        w.ind_var = Vec::new();
+    }
+    values.map = Default::default();
     (work, values, capped)
 }

@@ -24,6 +24,9 @@ pub(super) struct Values {
     /// strata): what the refinement's test takes for noise.
     pub indirect_var: HashMap<At, f64>,
     pub rays: u64,
+    /// Distinct points gathered in all, `map`'s and `indirect`'s (counted as they are
+    /// inserted: what is no longer read is dropped from both as the refinement goes).
+    pub gathered: u64,
 }
 
 /// One patch's elements while they are refined.
