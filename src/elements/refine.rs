@@ -50,7 +50,6 @@ use crate::mesh::Mesh;
 use crate::solve::{rng_for, scalar, Stream};
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
-use std::collections::HashSet;
 
 /// A corner on a patch's boundary is gathered this fraction of the way towards the patch's
 /// centre.
@@ -290,28 +289,42 @@ impl<I: Intersector> Refiner<'_, I> {
         (b, var, rays)
     }
 
-    /// Gathers the points `want` lists (per patch: the points' parameters, by root) that
-    /// `values` does not hold yet: each new one once, by the lowest-numbered patch asking,
-    /// all in parallel.
-    fn gather_all(&self, work: &[PatchWork], want: &[Vec<(u32, DVec2)>], values: &mut Values) {
-        let mut seen = HashSet::new();
-        let mut todo = Vec::new();
-        for (i, list) in want.iter().enumerate() {
-            for &(root, uv) in list {
-                let (at, x) = self.at(i, &work[i], root, uv);
-                if !values.map.contains_key(&at) && seen.insert(at) {
-                    todo.push((at, i, x));
+    /// Gathers the points `want` lists for each patch (the points' parameters, by root) that
+    /// `values` does not hold yet: each new one once, by the lowest-numbered patch asking, in
+    /// parallel. Patches are listed and gathered a [`GATHER_CHUNK`] at a time, in order (the
+    /// same patch gathers each point as if all were listed at once), and `values.map` itself
+    /// marks what is asked for already, so what the listing holds stays small on a large
+    /// model.
+    fn gather_all(
+        &self,
+        work: &[PatchWork],
+        want: impl Fn(&PatchWork) -> Vec<(u32, DVec2)> + Sync,
+        values: &mut Values,
+    ) {
+        for lo in (0..work.len()).step_by(GATHER_CHUNK) {
+            let hi = (lo + GATHER_CHUNK).min(work.len());
+            let lists: Vec<Vec<(u32, DVec2)>> = work[lo..hi].par_iter().map(|w| want(w)).collect();
+            let mut todo = Vec::new();
+            for (i, list) in (lo..hi).zip(&lists) {
+                for &(root, uv) in list {
+                    let (at, x) = self.at(i, &work[i], root, uv);
+                    if let std::collections::hash_map::Entry::Vacant(v) = values.map.entry(at) {
+                        // Filled below, before anything reads it.
+                        v.insert([0.0; 3]);
+                        todo.push((at, i, x));
+                    }
                 }
             }
-        }
-        let got: Vec<([f64; 3], f64, u64)> = todo
-            .par_iter()
-            .map(|&(_, i, x)| self.gather_one(i, x))
-            .collect();
-        for ((at, _, _), (b, _, rays)) in todo.into_iter().zip(got) {
-            values.map.insert(at, b);
-            values.rays += rays;
-            values.gathered += 1;
+            drop(lists);
+            let got: Vec<([f64; 3], f64, u64)> = todo
+                .par_iter()
+                .map(|&(_, i, x)| self.gather_one(i, x))
+                .collect();
+            for ((at, _, _), (b, _, rays)) in todo.into_iter().zip(got) {
+                values.map.insert(at, b);
+                values.rays += rays;
+                values.gathered += 1;
+            }
         }
     }
 
@@ -526,6 +539,9 @@ impl<I: Intersector> Refiner<'_, I> {
 /// only above 3σ) left one cut in the 20 and 1.27 % (docs/results/adaptive-elements.md).
 pub(super) const NOISE_Z: f64 = 2.0;
 
+/// Patches whose points [`Refiner::gather_all`] lists and gathers at a time.
+const GATHER_CHUNK: usize = 1 << 16;
+
 /// Whether `e` is at least twice the smallest element edge along its longer side.
 fn big_enough(e: &Elem, w: &PatchWork, min_size: f64) -> bool {
     let (along_u, along_v) = e.extents(&w.roots);
@@ -569,14 +585,12 @@ pub(super) fn finish<I: Intersector>(
     work: &mut [PatchWork],
     values: &mut Values,
 ) {
-    let want: Vec<Vec<(u32, DVec2)>> = (work.iter())
-        .map(|w| {
-            (w.done.iter())
-                .flat_map(|e| e.corners_uv().iter().map(move |&uv| (e.root, uv)))
-                .collect()
-        })
-        .collect();
-    r.gather_all(work, &want, values);
+    let corners = |w: &PatchWork| {
+        (w.done.iter())
+            .flat_map(|e| e.corners_uv().iter().map(move |&uv| (e.root, uv)))
+            .collect()
+    };
+    r.gather_all(work, corners, values);
     let v = &*values;
     // Per patch, its kept corners' direct light (what `values.map` holds).
     let direct: Vec<Vec<[f64; 3]>> = (work.par_iter().enumerate())
@@ -705,8 +719,7 @@ pub(super) fn run<I: Intersector>(
             }
             break;
         }
-        let want: Vec<Vec<(u32, DVec2)>> = work.par_iter().map(|w| r.wanted(w, rule)).collect();
-        r.gather_all(&work, &want, &mut values);
+        r.gather_all(&work, |w| r.wanted(w, rule), &mut values);
         let v = &values;
         let cands: Vec<Vec<(f64, usize, Cut)>> = work
             .par_iter_mut()
