@@ -303,7 +303,7 @@ impl<I: Intersector> Refiner<'_, I> {
     ) {
         for lo in (0..work.len()).step_by(GATHER_CHUNK) {
             let hi = (lo + GATHER_CHUNK).min(work.len());
-            let lists: Vec<Vec<(u32, DVec2)>> = work[lo..hi].par_iter().map(|w| want(w)).collect();
+            let lists: Vec<Vec<(u32, DVec2)>> = work[lo..hi].par_iter().map(&want).collect();
             let mut todo = Vec::new();
             for (i, list) in (lo..hi).zip(&lists) {
                 for &(root, uv) in list {
