@@ -661,18 +661,9 @@ pub(super) fn finish<I: Intersector>(
             }
         });
 }
-/// Runs the refinement of every patch to its fixed point under `rule`, with at most `cap`
-/// elements in all (the candidates with the largest contrast are cut first; patch order
-/// breaks ties), and gathers the kept elements' corners ([`finish`]). Returns each patch's
-/// work, the values gathered and whether the cap stopped it. Ctrl-C or the deadline
-/// ([`Refiner::stop`]) ends it at the next level, keeping what is refined.
-pub(super) fn run<I: Intersector>(
-    r: &Refiner<'_, I>,
-    rule: Rule,
-    cap: usize,
-) -> (Vec<PatchWork>, Values, bool) {
-    let mesh = r.mesh;
-    let mut work: Vec<PatchWork> = (0..mesh.patches.len())
+/// Each patch's refinement state before the first level: its roots, each one active.
+fn patch_work(mesh: &Mesh) -> Vec<PatchWork> {
+    (0..mesh.patches.len())
         .map(|i| {
             let pts: Vec<Vec3> = mesh
                 .patch_indices(i)
@@ -695,7 +686,20 @@ pub(super) fn run<I: Intersector>(
                 ind_var: Vec::new(),
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Runs the refinement of every patch to its fixed point under `rule`, with at most `cap`
+/// elements in all (the candidates with the largest contrast are cut first; patch order
+/// breaks ties), and gathers the kept elements' corners ([`finish`]). Returns each patch's
+/// work, the values gathered and whether the cap stopped it. Ctrl-C or the deadline
+/// ([`Refiner::stop`]) ends it at the next level, keeping what is refined.
+pub(super) fn run<I: Intersector>(
+    r: &Refiner<'_, I>,
+    rule: Rule,
+    cap: usize,
+) -> (Vec<PatchWork>, Values, bool) {
+    let mut work = patch_work(r.mesh);
     let mut values = Values::default();
     if r.light == CornerLight::Split {
         super::indirect::gather(
