@@ -43,7 +43,6 @@ use crate::solve::{rng_for, scalar, Stream};
 use glam::{DVec2, DVec3, Vec3};
 use rand::Rng;
 use rayon::prelude::*;
-use std::collections::HashSet;
 
 /// The nodes of root element `e`'s quadratic: its corners, then its edge midpoints (edge k
 /// from corner k), then a quad's centre — the points of its first midpoint test. The first
@@ -129,30 +128,41 @@ fn weights(n: usize, uv: DVec2) -> Vec<f64> {
 /// `scenes/spot.obj`, 0.3 the fewest rays; docs/results/adaptive-elements.md).
 pub const SPREAD: f64 = 0.3;
 
-/// Gathers each distinct point of `points` that `values.indirect` lacks, once (by the first
-/// patch listing it), in parallel.
+/// Gathers each distinct point that `list` gives the patches `patches` (in increasing order)
+/// and `values.indirect` lacks, once, by the first patch listing it, in parallel: listed and
+/// gathered [`CHUNK`] patches at a time, the map itself marking what is asked for already,
+/// so that what the listing holds stays small on a large model.
 fn gather_points(
-    points: &[(usize, Vec<(At, DVec3)>)],
+    work: &[PatchWork],
+    patches: &[usize],
+    list: impl Fn(usize, &PatchWork) -> Vec<(At, DVec3)> + Sync,
     indirect: &(impl Fn(usize, DVec3) -> ([f64; 3], f64, u64) + Sync),
     values: &mut Values,
 ) {
-    let mut seen = HashSet::new();
-    let mut todo = Vec::new();
-    for (i, list) in points {
-        for &(at, x) in list {
-            if !values.indirect.contains_key(&at) && seen.insert(at) {
-                todo.push((at, *i, x));
+    for chunk in patches.chunks(CHUNK) {
+        let lists: Vec<Vec<(At, DVec3)>> = chunk.par_iter().map(|&i| list(i, &work[i])).collect();
+        let mut todo = Vec::new();
+        for (&i, points) in chunk.iter().zip(&lists) {
+            for &(at, x) in points {
+                if let std::collections::hash_map::Entry::Vacant(v) = values.indirect.entry(at) {
+                    // Filled below, before anything reads it.
+                    v.insert(([0.0; 3], 0.0));
+                    todo.push((at, i, x));
+                }
             }
         }
-    }
-    let got: Vec<_> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
-    for ((at, _, _), (b, var, n)) in todo.into_iter().zip(got) {
-        values.indirect.insert(at, b);
-        values.indirect_var.insert(at, var);
-        values.rays += n;
-        values.gathered += 1;
+        drop(lists);
+        let got: Vec<_> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
+        for ((at, _, _), (b, var, n)) in todo.into_iter().zip(got) {
+            values.indirect.insert(at, (b, var));
+            values.rays += n;
+            values.gathered += 1;
+        }
     }
 }
+
+/// Patches whose nodes [`gather_points`] lists and gathers at a time.
+const CHUNK: usize = 1 << 16;
 
 /// Gathers the indirect light at the nodes of the roots of every patch that `near` marks
 /// ([`near_patches`]) into `values.indirect` and sets those patches'
@@ -181,23 +191,36 @@ pub(super) fn gather(
             })
             .collect()
     };
-    let corners: Vec<(usize, Vec<(At, DVec3)>)> = (work.par_iter().enumerate())
-        .filter(|(i, _)| near[*i])
-        .map(|(i, w)| (i, points(i, w, false).concat()))
-        .collect();
-    gather_points(&corners, &indirect, values);
+    let near_ones: Vec<usize> = (0..work.len()).filter(|&i| near[i]).collect();
+    gather_points(
+        work,
+        &near_ones,
+        |i, w| points(i, w, false).concat(),
+        &indirect,
+        values,
+    );
     let v = &*values;
     let mut all = vec![false; work.len()];
-    for (i, list) in &corners {
-        let s: Vec<f64> = list.iter().map(|(a, _)| scalar(&v.indirect[a])).collect();
-        let (lo, hi) = (s.iter()).fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
-        all[*i] = hi - lo > SPREAD * s.iter().sum::<f64>() / s.len().max(1) as f64;
-    }
-    let rest: Vec<(usize, Vec<(At, DVec3)>)> = (work.par_iter().enumerate())
-        .filter(|(i, _)| all[*i])
-        .map(|(i, w)| (i, points(i, w, true).concat()))
+    let spread: Vec<bool> = (near_ones.par_iter())
+        .map(|&i| {
+            let s: Vec<f64> = (points(i, &work[i], false).iter().flatten())
+                .map(|(a, _)| scalar(&v.indirect[a].0))
+                .collect();
+            let (lo, hi) = (s.iter()).fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
+            hi - lo > SPREAD * s.iter().sum::<f64>() / s.len().max(1) as f64
+        })
         .collect();
-    gather_points(&rest, &indirect, values);
+    for (&i, &wide) in near_ones.iter().zip(&spread) {
+        all[i] = wide;
+    }
+    let wide: Vec<usize> = (0..work.len()).filter(|&i| all[i]).collect();
+    gather_points(
+        work,
+        &wide,
+        |i, w| points(i, w, true).concat(),
+        &indirect,
+        values,
+    );
     let v = &*values;
     work.par_iter_mut().enumerate().for_each(|(i, w)| {
         if !near[i] {
@@ -205,15 +228,14 @@ pub(super) fn gather(
         }
         let pts = points(i, w, all[i]);
         w.ind_nodes = (pts.iter())
-            .map(|root| root.iter().map(|(at, _)| v.indirect[at]).collect())
+            .map(|root| root.iter().map(|(at, _)| v.indirect[at].0).collect())
             .collect();
         w.ind_var = (pts.iter())
-            .map(|root| root.iter().map(|(at, _)| v.indirect_var[at]).collect())
+            .map(|root| root.iter().map(|(at, _)| v.indirect[at].1).collect())
             .collect();
     });
     // Each patch holds its nodes' values now; the maps only served to gather each point once.
     values.indirect = Default::default();
-    values.indirect_var = Default::default();
 }
 
 /// Hemisphere rays each patch casts from its centre to find how near the geometry it sees is

@@ -785,6 +785,8 @@ pub(super) fn run<I: Intersector>(
     finish(r, &mut work, &mut values);
     // The display reads each patch's roots, kept elements and their corners' values only.
     for w in &mut work {
+        // A vector grown from empty holds room for four elements; most patches keep one.
+        w.done.shrink_to_fit();
         w.active = Vec::new();
         w.indirect = Vec::new();
         w.ind_nodes = Vec::new();

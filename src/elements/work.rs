@@ -18,11 +18,10 @@ pub(super) struct At(pub [i64; 3], pub [i32; 3], pub u32);
 #[derive(Default)]
 pub(super) struct Values {
     pub map: HashMap<At, [f64; 3]>,
-    /// [`super::CornerLight::Split`]: the indirect light at the patches' corners.
-    pub indirect: HashMap<At, [f64; 3]>,
-    /// The variance of each of `indirect`'s values (scalar; the gather's own, from its
-    /// strata): what the refinement's test takes for noise.
-    pub indirect_var: HashMap<At, f64>,
+    /// [`super::CornerLight::Split`]: the indirect light at the patches' nodes, and the
+    /// variance of each (scalar; the gather's own, from its strata: what the refinement's
+    /// test takes for noise).
+    pub indirect: HashMap<At, ([f64; 3], f64)>,
     pub rays: u64,
     /// Distinct points gathered in all, `map`'s and `indirect`'s (counted as they are
     /// inserted: what is no longer read is dropped from both as the refinement goes).
