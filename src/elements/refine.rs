@@ -328,14 +328,16 @@ impl<I: Intersector> Refiner<'_, I> {
         }
     }
 
-    /// Forgets the centres of the quads kept so far (their tests read them): a kept element
-    /// is never cut again, and nothing else of its patch lies inside it, so no decision and no
-    /// corner reads them again. (A patch that lies on another — a doubled face of the same
-    /// facing and material — would gather such a point again itself.)
-    fn forget_centres(&self, work: &[PatchWork], values: &mut Values) {
-        let gone: Vec<At> = (work.par_iter().enumerate())
-            .flat_map_iter(|(i, w)| {
-                (w.done.iter().filter(|e| !e.tri))
+    /// Forgets the centres of the quads this level kept (each patch's `done` from
+    /// `decided_from`: the cut candidates were swapped out from among them, the earlier kept
+    /// ones stay below): a kept element is never cut again, and nothing else of its patch lies
+    /// inside it, so no decision and no corner reads them again. (A patch that lies on
+    /// another — a doubled face of the same facing and material — would gather such a point
+    /// again itself.)
+    fn forget_centres(&self, work: &[PatchWork], decided_from: &[usize], values: &mut Values) {
+        let gone: Vec<At> = (work.par_iter().zip(decided_from).enumerate())
+            .flat_map_iter(|(i, (w, &from))| {
+                (w.done[from..].iter().filter(|e| !e.tri))
                     .map(move |e| self.at(i, w, e.root, e.centre_uv()).0)
             })
             .collect();
@@ -725,6 +727,8 @@ pub(super) fn run<I: Intersector>(
         }
         r.gather_all(&work, |w| r.wanted(w, rule), &mut values);
         let v = &values;
+        // Kept elements sit in `done` below these; the level's candidates are put after.
+        let decided_from: Vec<usize> = work.iter().map(|w| w.done.len()).collect();
         let cands: Vec<Vec<(f64, usize, Cut)>> = work
             .par_iter_mut()
             .enumerate()
@@ -772,7 +776,7 @@ pub(super) fn run<I: Intersector>(
                 w.active.extend(e.cut(how));
             }
         }
-        r.forget_centres(&work, &mut values);
+        r.forget_centres(&work, &decided_from, &mut values);
         if capped {
             // Whatever is still active after the cap is kept as it is.
             for w in &mut work {
