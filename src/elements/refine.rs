@@ -328,12 +328,10 @@ impl<I: Intersector> Refiner<'_, I> {
         }
     }
 
-    /// Forgets the centres of the quads this level kept (each patch's `done` from
-    /// `decided_from`: the cut candidates were swapped out from among them, the earlier kept
-    /// ones stay below): a kept element is never cut again, and nothing else of its patch lies
-    /// inside it, so no decision and no corner reads them again. (A patch that lies on
-    /// another — a doubled face of the same facing and material — would gather such a point
-    /// again itself.)
+    /// Forgets the centres of the quads this level kept (`done` from `decided_from`): a kept
+    /// element is never cut again and nothing else of its patch lies inside it, so nothing
+    /// reads them again (but a doubled face of the same facing and material, which would
+    /// gather such a point again itself).
     fn forget_centres(&self, work: &[PatchWork], decided_from: &[usize], values: &mut Values) {
         let gone: Vec<At> = (work.par_iter().zip(decided_from).enumerate())
             .flat_map_iter(|(i, (w, &from))| {
