@@ -62,9 +62,9 @@ fn nodes(e: &Elem) -> Vec<DVec2> {
 /// order of `nodes`; a patch's [`PatchWork::ind_nodes`]): bilinear from a quad's 4 corners,
 /// affine from a triangle's 3, the quadratic through all the nodes (biquadratic on a quad's
 /// 3 × 3, the six-node quadratic on a triangle); not below 0.
-pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
+pub(super) fn at(f: &[([f64; 3], f64)], uv: DVec2) -> [f64; 3] {
     let mut out = [0.0; 3];
-    for (x, wt) in f.iter().zip(weights(f.len(), uv)) {
+    for ((x, _), wt) in f.iter().zip(weights(f.len(), uv)) {
         for c in 0..3 {
             out[c] += wt * x[c];
         }
@@ -72,10 +72,10 @@ pub(super) fn at(f: &[[f64; 3]], uv: DVec2) -> [f64; 3] {
     out.map(|x| x.max(0.0))
 }
 
-/// The variance of [`at`]'s value from independent nodes of variances `var`: Σ wₖ² σₖ².
-pub(super) fn var_at(var: &[f64], uv: DVec2) -> f64 {
-    (var.iter().zip(weights(var.len(), uv)))
-        .map(|(v, wt)| wt * wt * v)
+/// The variance of [`at`]'s value from independent nodes `f` (their variances σₖ²): Σ wₖ² σₖ².
+pub(super) fn var_at(f: &[([f64; 3], f64)], uv: DVec2) -> f64 {
+    (f.iter().zip(weights(f.len(), uv)))
+        .map(|((_, v), wt)| wt * wt * v)
         .sum()
 }
 
@@ -228,10 +228,7 @@ pub(super) fn gather(
         }
         let pts = points(i, w, all[i]);
         w.ind_nodes = (pts.iter())
-            .map(|root| root.iter().map(|(at, _)| v.indirect[at].0).collect())
-            .collect();
-        w.ind_var = (pts.iter())
-            .map(|root| root.iter().map(|(at, _)| v.indirect[at].1).collect())
+            .map(|root| root.iter().map(|(at, _)| v.indirect[at]).collect())
             .collect();
     });
     // Each patch holds its nodes' values now; the maps only served to gather each point once.
@@ -306,7 +303,8 @@ mod tests {
             let roots = Root::of_patch(pts);
             let e = roots[0].element(0);
             let f = |uv: DVec2| 1.0 + 2.0 * uv.x - uv.y + 3.0 * uv.x * uv.y + uv.x * uv.x;
-            let values: Vec<[f64; 3]> = nodes(&e).iter().map(|&uv| [f(uv); 3]).collect();
+            let values: Vec<([f64; 3], f64)> =
+                nodes(&e).iter().map(|&uv| ([f(uv); 3], 0.0)).collect();
             for uv in [DVec2::new(0.3, 0.2), DVec2::new(0.125, 0.625)] {
                 assert!((at(&values, uv)[1] - f(uv)).abs() < 1e-12);
             }

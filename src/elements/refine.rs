@@ -258,7 +258,7 @@ impl<I: Intersector> Refiner<'_, I> {
         if self.light != CornerLight::Split || !self.near[patch] {
             return 0.0;
         }
-        super::indirect::var_at(&w.ind_var[root as usize], uv)
+        super::indirect::var_at(&w.ind_nodes[root as usize], uv)
     }
 
     /// Gathers at `x`, as patch `patch` (module notes): the direct light, or all of it.
@@ -683,7 +683,6 @@ fn patch_work(mesh: &Mesh) -> Vec<PatchWork> {
                 done: Vec::new(),
                 corner_b: Vec::new(),
                 ind_nodes: Vec::new(),
-                ind_var: Vec::new(),
             }
         })
         .collect()
@@ -792,7 +791,6 @@ pub(super) fn run<I: Intersector>(
         w.active = Vec::new();
         w.indirect = Vec::new();
         w.ind_nodes = Vec::new();
-        w.ind_var = Vec::new();
     }
     values.map = Default::default();
     (work, values, capped)

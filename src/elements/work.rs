@@ -41,10 +41,8 @@ pub(super) struct PatchWork {
     /// once the refinement ends: [`super::refine::finish`]).
     pub corner_b: Vec<[f64; 3]>,
     /// [`super::CornerLight::Split`]: per root, the indirect light at its quadratic's nodes
-    /// ([`super::indirect`]).
-    pub ind_nodes: Vec<Vec<[f64; 3]>>,
-    /// The variance of each of `ind_nodes`' values.
-    pub ind_var: Vec<Vec<f64>>,
+    /// ([`super::indirect`]), each with the variance of its value.
+    pub ind_nodes: Vec<Vec<([f64; 3], f64)>>,
 }
 
 /// The cache key of a position.
