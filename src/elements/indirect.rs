@@ -34,7 +34,7 @@
 //! corners agree, the light between them is as flat as the noise can tell.
 
 use super::geometry::Elem;
-use super::work::{At, PatchWork, Values};
+use super::work::{gather_new, At, PatchWork, Values, CHUNK};
 use crate::intersect::Intersector;
 use crate::light::LightAt;
 use crate::mesh::Mesh;
@@ -129,40 +129,29 @@ fn weights(n: usize, uv: DVec2) -> Vec<f64> {
 pub const SPREAD: f64 = 0.3;
 
 /// Gathers each distinct point that `list` gives the patches `patches` (in increasing order)
-/// and `values.indirect` lacks, once, by the first patch listing it, in parallel: listed and
-/// gathered [`CHUNK`] patches at a time, the map itself marking what is asked for already,
-/// so that what the listing holds stays small on a large model.
+/// and `values.indirect` lacks, once ([`gather_new`], [`CHUNK`] patches at a time).
 fn gather_points(
     work: &[PatchWork],
     patches: &[usize],
-    list: impl Fn(usize, &PatchWork) -> Vec<(At, DVec3)> + Sync,
+    list: impl Fn(usize, &PatchWork) -> Vec<(At, DVec3)> + Sync + Send,
     indirect: &(impl Fn(usize, DVec3) -> ([f64; 3], f64, u64) + Sync),
     values: &mut Values,
 ) {
     for chunk in patches.chunks(CHUNK) {
-        let lists: Vec<Vec<(At, DVec3)>> = chunk.par_iter().map(|&i| list(i, &work[i])).collect();
-        let mut todo = Vec::new();
-        for (&i, points) in chunk.iter().zip(&lists) {
-            for &(at, x) in points {
-                if let std::collections::hash_map::Entry::Vacant(v) = values.indirect.entry(at) {
-                    // Filled below, before anything reads it.
-                    v.insert(([0.0; 3], 0.0));
-                    todo.push((at, i, x));
-                }
-            }
-        }
-        drop(lists);
-        let got: Vec<_> = (todo.par_iter()).map(|&(_, i, x)| indirect(i, x)).collect();
-        for ((at, _, _), (b, var, n)) in todo.into_iter().zip(got) {
-            values.indirect.insert(at, (b, var));
-            values.rays += n;
-            values.gathered += 1;
-        }
+        let (rays, gathered) = gather_new(
+            &mut values.indirect,
+            chunk.par_iter().copied(),
+            (|i| list(i, &work[i]), |_, p| p),
+            |i, x| {
+                let (b, var, n) = indirect(i, x);
+                ((b, var), n)
+            },
+            ([0.0; 3], 0.0),
+        );
+        values.rays += rays;
+        values.gathered += gathered;
     }
 }
-
-/// Patches whose nodes [`gather_points`] lists and gathers at a time.
-const CHUNK: usize = 1 << 16;
 
 /// Gathers the indirect light at the nodes of the roots of every patch that `near` marks
 /// ([`near_patches`]) into `values.indirect` and sets those patches'

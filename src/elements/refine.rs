@@ -42,8 +42,8 @@
 //! on the thread count.
 
 use super::geometry::{Cut, Elem, Root};
-use super::work::on_edges;
 pub(super) use super::work::{facing, inner_edges, key, At, PatchWork, Values};
+use super::work::{gather_new, on_edges, CHUNK};
 use crate::intersect::Intersector;
 use crate::light::{LightAt, LightParts};
 use crate::mesh::Mesh;
@@ -291,40 +291,27 @@ impl<I: Intersector> Refiner<'_, I> {
 
     /// Gathers the points `want` lists for each patch (the points' parameters, by root) that
     /// `values` does not hold yet: each new one once, by the lowest-numbered patch asking, in
-    /// parallel. Patches are listed and gathered a [`GATHER_CHUNK`] at a time, in order (the
-    /// same patch gathers each point as if all were listed at once), and `values.map` itself
-    /// marks what is asked for already, so what the listing holds stays small on a large
-    /// model.
+    /// parallel ([`gather_new`], a [`CHUNK`] of patches at a time, in order: the same patch
+    /// gathers each point as if all were listed at once).
     fn gather_all(
         &self,
         work: &[PatchWork],
-        want: impl Fn(&PatchWork) -> Vec<(u32, DVec2)> + Sync,
+        want: impl Fn(&PatchWork) -> Vec<(u32, DVec2)> + Sync + Send,
         values: &mut Values,
     ) {
-        for lo in (0..work.len()).step_by(GATHER_CHUNK) {
-            let hi = (lo + GATHER_CHUNK).min(work.len());
-            let lists: Vec<Vec<(u32, DVec2)>> = work[lo..hi].par_iter().map(&want).collect();
-            let mut todo = Vec::new();
-            for (i, list) in (lo..hi).zip(&lists) {
-                for &(root, uv) in list {
-                    let (at, x) = self.at(i, &work[i], root, uv);
-                    if let std::collections::hash_map::Entry::Vacant(v) = values.map.entry(at) {
-                        // Filled below, before anything reads it.
-                        v.insert([0.0; 3]);
-                        todo.push((at, i, x));
-                    }
-                }
-            }
-            drop(lists);
-            let got: Vec<([f64; 3], f64, u64)> = todo
-                .par_iter()
-                .map(|&(_, i, x)| self.gather_one(i, x))
-                .collect();
-            for ((at, _, _), (b, _, rays)) in todo.into_iter().zip(got) {
-                values.map.insert(at, b);
-                values.rays += rays;
-                values.gathered += 1;
-            }
+        for lo in (0..work.len()).step_by(CHUNK) {
+            let hi = (lo + CHUNK).min(work.len());
+            let list = |i: usize| want(&work[i]);
+            let locate = |i: usize, (root, uv)| self.at(i, &work[i], root, uv);
+            let gather = |i, x| {
+                let (b, _, rays) = self.gather_one(i, x);
+                (b, rays)
+            };
+            let chunk = (lo..hi).into_par_iter();
+            let (rays, gathered) =
+                gather_new(&mut values.map, chunk, (list, locate), gather, [0.0; 3]);
+            values.rays += rays;
+            values.gathered += gathered;
         }
     }
 
@@ -538,9 +525,6 @@ impl<I: Intersector> Refiner<'_, I> {
 /// off, 1.22 % with 1.5, 1.23 % with 2 (ratio 0.49 to uniform meshing). A bare cut-off (cut
 /// only above 3σ) left one cut in the 20 and 1.27 % (docs/results/adaptive-elements.md).
 pub(super) const NOISE_Z: f64 = 2.0;
-
-/// Patches whose points [`Refiner::gather_all`] lists and gathers at a time.
-const GATHER_CHUNK: usize = 1 << 16;
 
 /// Whether `e` is at least twice the smallest element edge along its longer side.
 fn big_enough(e: &Elem, w: &PatchWork, min_size: f64) -> bool {

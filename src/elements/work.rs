@@ -7,6 +7,7 @@
 use super::geometry::{Elem, Root};
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3, Vec3};
+use rayon::prelude::*;
 use std::collections::{HashMap, HashSet};
 
 /// Where a point's value is kept ([`super::refine`]'s notes, "Shared points"): its position,
@@ -26,6 +27,46 @@ pub(super) struct Values {
     /// Distinct points gathered in all, `map`'s and `indirect`'s (counted as they are
     /// inserted: what is no longer read is dropped from both as the refinement goes).
     pub gathered: u64,
+}
+
+/// Patches whose points [`gather_new`] is handed at a time by its callers: what the listing
+/// holds stays small on a large model.
+pub(super) const CHUNK: usize = 1 << 16;
+
+/// Gathers each distinct point that `list` gives the patches of `chunk` (in increasing order;
+/// `locate` says where each listed point is kept and lies) and `map` lacks, once, by the first
+/// patch listing it, in parallel, into `map`: the map itself marks what is asked for already
+/// (`blank` until gathered). Returns the rays cast and the points gathered.
+pub(super) fn gather_new<P: Copy + Send, V: Copy + Send + Sync>(
+    map: &mut HashMap<At, V>,
+    chunk: impl IndexedParallelIterator<Item = usize>,
+    (list, locate): (
+        impl Fn(usize) -> Vec<P> + Sync + Send,
+        impl Fn(usize, P) -> (At, DVec3),
+    ),
+    gather: impl Fn(usize, DVec3) -> (V, u64) + Sync + Send,
+    blank: V,
+) -> (u64, u64) {
+    let lists: Vec<(usize, Vec<P>)> = chunk.map(|i| (i, list(i))).collect();
+    let mut todo = Vec::new();
+    for (i, points) in &lists {
+        for &p in points {
+            let (at, x) = locate(*i, p);
+            if let std::collections::hash_map::Entry::Vacant(v) = map.entry(at) {
+                // Filled below, before anything reads it.
+                v.insert(blank);
+                todo.push((at, *i, x));
+            }
+        }
+    }
+    drop(lists);
+    let got: Vec<(V, u64)> = (todo.par_iter()).map(|&(_, i, x)| gather(i, x)).collect();
+    let (mut rays, gathered) = (0, todo.len() as u64);
+    for ((at, _, _), (value, n)) in todo.into_iter().zip(got) {
+        map.insert(at, value);
+        rays += n;
+    }
+    (rays, gathered)
 }
 
 /// One patch's elements while they are refined.
