@@ -38,7 +38,11 @@ fn the_target_is_reached_and_the_true_error_falls_with_it() {
     };
     let refined = run(&s, &m, &cfg);
     let t = refined.stats.error_target.unwrap();
-    assert!(t.reached && t.estimate <= target && t.passes >= 2, "{t:?}");
+    // A further pass or gather round (whichever the counted work says reaches it cheaper).
+    assert!(
+        t.reached && t.estimate <= target && t.passes + t.regathers >= 2,
+        "{t:?}"
+    );
     assert!((estimate_of(&refined) - t.estimate).abs() < 1e-12);
     let true_plain = estimate::against(&area, &plain.b, &reference.b).weighted_percent;
     let true_refined = estimate::against(&area, &refined.b, &reference.b).weighted_percent;
