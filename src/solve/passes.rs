@@ -27,7 +27,7 @@
 //! pass, the gathers of the last combination are asked for a round of extra rays placed where
 //! the estimate's error is ([`final_gather::Gathers::plan`]); it is taken instead of the pass
 //! when it is expected to cast fewer rays than the passes would to reach the same aim, their
-//! gathers included ([`Route`]; counted, not timed), and pooled with the gathers it adds to.
+//! gathers included (`Route`; counted, not timed), and pooled with the gathers it adds to.
 //! At most [`MAX_REGATHERS`] rounds.
 //!
 //! **Judging** a combination: per patch, noise sqrt(Σ w_k² σ_kj²) and light not yet shot
@@ -631,9 +631,9 @@ mod tests {
     use super::{rate, Route};
 
     /// The office-sized case that went wrong: a first pass of 6.2 M samples with a 3.5 M-ray
-    /// gather at 17 %, aiming at 4.25 %: the passes need 16× the samples again (96 M) and
-    /// their gathers 58 M more; a round planned at 108 M rays wins, though one pass capped at
-    /// 3× (19 M samples, 14 M of gather) would have looked cheaper.
+    /// gather at 17 %, aiming at 4.25 %: the passes need 15× the samples again (93 M) and
+    /// their gathers 56 M; a round planned at 108 M rays wins, though one pass capped at 3×
+    /// (19 M samples, 14 M of gather) would have looked cheaper.
     #[test]
     fn a_round_is_weighed_against_the_whole_route_of_passes() {
         let so_far = 6.2e6;
