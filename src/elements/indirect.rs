@@ -34,7 +34,7 @@
 //! corners agree, the light between them is as flat as the noise can tell.
 
 use super::geometry::Elem;
-use super::work::{gather_new, At, PatchWork, Values, CHUNK};
+use super::work::{gather_new, At, PatchWork, Values};
 use crate::intersect::Intersector;
 use crate::light::LightAt;
 use crate::mesh::Mesh;
@@ -129,7 +129,7 @@ fn weights(n: usize, uv: DVec2) -> Vec<f64> {
 pub const SPREAD: f64 = 0.3;
 
 /// Gathers each distinct point that `list` gives the patches `patches` (in increasing order)
-/// and `values.indirect` lacks, once ([`gather_new`], [`CHUNK`] patches at a time).
+/// and `values.indirect` lacks, once ([`gather_new`]).
 fn gather_points(
     work: &[PatchWork],
     patches: &[usize],
@@ -137,20 +137,18 @@ fn gather_points(
     indirect: &(impl Fn(usize, DVec3) -> ([f64; 3], f64, u64) + Sync),
     values: &mut Values,
 ) {
-    for chunk in patches.chunks(CHUNK) {
-        let (rays, gathered) = gather_new(
-            &mut values.indirect,
-            chunk.par_iter().copied(),
-            (|i| list(i, &work[i]), |_, p| p),
-            |i, x| {
-                let (b, var, n) = indirect(i, x);
-                ((b, var), n)
-            },
-            ([0.0; 3], 0.0),
-        );
-        values.rays += rays;
-        values.gathered += gathered;
-    }
+    let (rays, gathered) = gather_new(
+        &mut values.indirect,
+        (patches.len(), |k| patches[k]),
+        (|i| list(i, &work[i]), |_, p| p),
+        |i, x| {
+            let (b, var, n) = indirect(i, x);
+            ((b, var), n)
+        },
+        ([0.0; 3], 0.0),
+    );
+    values.rays += rays;
+    values.gathered += gathered;
 }
 
 /// Gathers the indirect light at the nodes of the roots of every patch that `near` marks

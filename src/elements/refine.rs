@@ -43,7 +43,7 @@
 
 use super::geometry::{Cut, Elem, Root};
 pub(super) use super::work::{facing, inner_edges, key, At, PatchWork, Values};
-use super::work::{gather_new, on_edges, CHUNK};
+use super::work::{gather_new, on_edges};
 use crate::intersect::Intersector;
 use crate::light::{LightAt, LightParts};
 use crate::mesh::Mesh;
@@ -291,28 +291,24 @@ impl<I: Intersector> Refiner<'_, I> {
 
     /// Gathers the points `want` lists for each patch (the points' parameters, by root) that
     /// `values` does not hold yet: each new one once, by the lowest-numbered patch asking, in
-    /// parallel ([`gather_new`], a [`CHUNK`] of patches at a time, in order: the same patch
-    /// gathers each point as if all were listed at once).
+    /// parallel ([`gather_new`]).
     fn gather_all(
         &self,
         work: &[PatchWork],
         want: impl Fn(&PatchWork) -> Vec<(u32, DVec2)> + Sync + Send,
         values: &mut Values,
     ) {
-        for lo in (0..work.len()).step_by(CHUNK) {
-            let hi = (lo + CHUNK).min(work.len());
-            let list = |i: usize| want(&work[i]);
-            let locate = |i: usize, (root, uv)| self.at(i, &work[i], root, uv);
-            let gather = |i, x| {
-                let (b, _, rays) = self.gather_one(i, x);
-                (b, rays)
-            };
-            let chunk = (lo..hi).into_par_iter();
-            let (rays, gathered) =
-                gather_new(&mut values.map, chunk, (list, locate), gather, [0.0; 3]);
-            values.rays += rays;
-            values.gathered += gathered;
-        }
+        let list = |i: usize| want(&work[i]);
+        let locate = |i: usize, (root, uv)| self.at(i, &work[i], root, uv);
+        let gather = |i, x| {
+            let (b, _, rays) = self.gather_one(i, x);
+            (b, rays)
+        };
+        let patches = (work.len(), |k| k);
+        let (rays, gathered) =
+            gather_new(&mut values.map, patches, (list, locate), gather, [0.0; 3]);
+        values.rays += rays;
+        values.gathered += gathered;
     }
 
     /// Forgets the centres of the quads this level kept (`done` from `decided_from`): a kept

@@ -29,17 +29,19 @@ pub(super) struct Values {
     pub gathered: u64,
 }
 
-/// Patches whose points [`gather_new`] is handed at a time by its callers: what the listing
-/// holds stays small on a large model.
-pub(super) const CHUNK: usize = 1 << 16;
+/// Patches whose points [`gather_new`] lists and gathers at a time: what the listing holds
+/// stays small on a large model.
+const CHUNK: usize = 1 << 16;
 
-/// Gathers each distinct point that `list` gives the patches of `chunk` (in increasing order;
-/// `locate` says where each listed point is kept and lies) and `map` lacks, once, by the first
-/// patch listing it, in parallel, into `map`: the map itself marks what is asked for already
-/// (`blank` until gathered). Returns the rays cast and the points gathered.
+/// Gathers each distinct point that `list` gives the patches `patch(0)`, …, `patch(n − 1)` (in
+/// increasing order; `locate` says where each listed point is kept and lies) and `map` lacks,
+/// once, by the first patch listing it, in parallel, into `map`, [`CHUNK`] patches at a time
+/// (the same patch gathers each point as if all were listed at once): the map itself marks
+/// what is asked for already (`blank` until gathered). Returns the rays cast and the points
+/// gathered.
 pub(super) fn gather_new<P: Copy + Send, V: Copy + Send + Sync>(
     map: &mut HashMap<At, V>,
-    chunk: impl IndexedParallelIterator<Item = usize>,
+    (n, patch): (usize, impl Fn(usize) -> usize + Sync + Send),
     (list, locate): (
         impl Fn(usize) -> Vec<P> + Sync + Send,
         impl Fn(usize, P) -> (At, DVec3),
@@ -47,24 +49,31 @@ pub(super) fn gather_new<P: Copy + Send, V: Copy + Send + Sync>(
     gather: impl Fn(usize, DVec3) -> (V, u64) + Sync + Send,
     blank: V,
 ) -> (u64, u64) {
-    let lists: Vec<(usize, Vec<P>)> = chunk.map(|i| (i, list(i))).collect();
-    let mut todo = Vec::new();
-    for (i, points) in &lists {
-        for &p in points {
-            let (at, x) = locate(*i, p);
-            if let std::collections::hash_map::Entry::Vacant(v) = map.entry(at) {
-                // Filled below, before anything reads it.
-                v.insert(blank);
-                todo.push((at, *i, x));
+    let (mut rays, mut gathered) = (0, 0);
+    for lo in (0..n).step_by(CHUNK) {
+        let hi = (lo + CHUNK).min(n);
+        let lists: Vec<(usize, Vec<P>)> = (lo..hi)
+            .into_par_iter()
+            .map(|k| (patch(k), list(patch(k))))
+            .collect();
+        let mut todo = Vec::new();
+        for (i, points) in &lists {
+            for &p in points {
+                let (at, x) = locate(*i, p);
+                if let std::collections::hash_map::Entry::Vacant(v) = map.entry(at) {
+                    // Filled below, before anything reads it.
+                    v.insert(blank);
+                    todo.push((at, *i, x));
+                }
             }
         }
-    }
-    drop(lists);
-    let got: Vec<(V, u64)> = (todo.par_iter()).map(|&(_, i, x)| gather(i, x)).collect();
-    let (mut rays, gathered) = (0, todo.len() as u64);
-    for ((at, _, _), (value, n)) in todo.into_iter().zip(got) {
-        map.insert(at, value);
-        rays += n;
+        drop(lists);
+        let got: Vec<(V, u64)> = (todo.par_iter()).map(|&(_, i, x)| gather(i, x)).collect();
+        gathered += todo.len() as u64;
+        for ((at, _, _), (value, r)) in todo.into_iter().zip(got) {
+            map.insert(at, value);
+            rays += r;
+        }
     }
     (rays, gathered)
 }
