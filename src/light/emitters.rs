@@ -230,14 +230,17 @@ impl Emitters {
             }
         }
         let mut open = BinaryHeap::new();
-        let mut done: Vec<(u32, f64)> = Vec::new();
+        // (the node's first place in the order, the node, its estimate): sorted by the first.
+        let mut done: Vec<(u32, u32, f64)> = Vec::new();
+        let start = |n: u32| self.nodes[n as usize].start as u32;
         // Files node n where it belongs; whether it can light r (then it holds a place).
-        let file = |n: u32, open: &mut BinaryHeap<Open>, done: &mut Vec<(u32, f64)>| {
-            let w = contribution(&self.nodes[n as usize], r);
+        let file = |n: u32, open: &mut BinaryHeap<Open>, done: &mut Vec<(u32, u32, f64)>| {
+            let node = &self.nodes[n as usize];
+            let w = contribution(node, r);
             if w > 0.0 {
-                match self.nodes[n as usize].children {
+                match node.children {
                     Some(_) => open.push(Open(w, n)),
-                    None => done.push((n, w)),
+                    None => done.push((node.start as u32, n, w)),
                 }
             }
             w > 0.0
@@ -246,11 +249,10 @@ impl Emitters {
         for &n in &self.roots {
             held += usize::from(file(n, &mut open, &mut done));
         }
-        while let Some(Open(w, n)) = open.pop() {
-            if held >= CLUSTERS {
-                done.push((n, w));
-                continue;
-            }
+        while held < CLUSTERS {
+            let Some(Open(_, n)) = open.pop() else {
+                break;
+            };
             let [a, b] = self.nodes[n as usize]
                 .children
                 .expect("only inner nodes are open");
@@ -258,8 +260,11 @@ impl Emitters {
             held += usize::from(file(a, &mut open, &mut done));
             held += usize::from(file(b, &mut open, &mut done));
         }
-        done.sort_unstable_by_key(|&(n, _)| self.nodes[n as usize].start);
-        done.into_iter().unzip()
+        // The cut is full: the nodes still open join it as they are (their order is the sort's).
+        done.extend(open.into_iter().map(|Open(w, n)| (start(n), n, w)));
+        // Nodes of a cut cover disjoint stretches of the order: their first places differ.
+        done.sort_unstable_by_key(|&(s, _, _)| s);
+        done.into_iter().map(|(_, n, w)| (n, w)).unzip()
     }
 
     /// The emitter (index into `patches`) that `s` ∈ [0, 1) picks by `draw`, its probability

@@ -5,13 +5,17 @@
 use crate::mesh::Mesh;
 use glam::Vec3;
 use rand::Rng;
+use smallvec::SmallVec;
 
 /// Draws points uniformly over the area of one convex patch: a fan triangle chosen by area,
 /// then a uniform point in it. Built once per chunk of rays, so no work per ray but the draw.
+/// The fan of a triangle or a quadrilateral is held inline: the emitters' points are read at
+/// random by every light sample, and a fan on the heap cost a second cache miss each
+/// (docs/results/pipeline-1m.md).
 pub struct PatchPoints {
     apex: Vec3,
     /// (b, c, cumulative area) of each fan triangle (apex, b, c).
-    fan: Vec<(Vec3, Vec3, f32)>,
+    fan: SmallVec<[(Vec3, Vec3, f32); 2]>,
 }
 
 impl PatchPoints {
