@@ -114,6 +114,11 @@ impl Draw {
     pub fn by_power() -> Draw {
         Draw { local: None }
     }
+
+    /// Whether the draw is a receiver's own (a cut), not by power.
+    pub fn is_local(&self) -> bool {
+        self.local.is_some()
+    }
 }
 
 /// The receiver a [`Draw`] is made for: its centre, normal and radius (0 for a point).

@@ -37,7 +37,10 @@
 //! that side's size does not take its B (constant over the patch: right seen from afar,
 //! wrong from beside it — the 0.5 m wall patch behind a shelf 5 cm in front of it is lit on
 //! its exposed part and dark behind the shelf). It takes the light at the point it met, from
-//! one light sample and one cosine ray there, followed the same way through the gap.
+//! one light sample and one cosine ray there, followed the same way through the gap. The
+//! followed point's light sample comes from the gathering point's own cut of the emitters
+//! mixed with a share by power ([`hemisphere::FOLLOWED_NEAR`]): the point lies within a patch's
+//! size of it, in the same room.
 //!
 //! **The point query** ([`LightAt`]): what a camera ray sees, the radiosity B = E + ρ·H
 //! leaving a side at some points of it (or its direct or indirect part, [`LightParts`]), the
