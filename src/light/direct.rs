@@ -3,7 +3,7 @@
 //! its density and counted at its MIS weight against the hemisphere rays (the balance
 //! heuristic, `Emitters::weight`).
 
-use super::emitters::Emitters;
+use super::emitters::{Emitter, Emitters};
 use super::gather::{latin, stratified_var, Gathered, Split, Spot};
 use super::{scalar, Kernel, Origin, Rgb};
 use crate::intersect::{Intersector, Ray};
@@ -20,9 +20,15 @@ pub(super) struct Shadow {
 
 impl<I: Intersector> Kernel<'_, I> {
     /// The irradiance sample (RGB, before dividing by the pdf of the emitter's choice) of a
-    /// shadow ray from `from` to `y` on emitter `j`: E_j·cosθ_i·cosθ_j/(π r²), or `None` when
-    /// `y` faces away or is not seen (no ray is cast when the geometry says 0).
-    pub(super) fn direct(&self, from: &Origin, j: usize, y: Vec3) -> Option<Shadow> {
+    /// shadow ray from `from` to `y` on emitting patch `j` (`em`: what is read of it):
+    /// E_j·cosθ_i·cosθ_j/(π r²), or `None` when `y` faces away or is not seen (no ray is cast
+    /// when the geometry says 0).
+    pub(super) fn direct(
+        &self,
+        from: &Origin,
+        (j, em): (usize, &Emitter),
+        y: Vec3,
+    ) -> Option<Shadow> {
         let (x, n, eps) = (from.x, from.n, from.eps);
         let d = y - x;
         let dist = d.length();
@@ -31,7 +37,7 @@ impl<I: Intersector> Kernel<'_, I> {
         }
         let dir = d / dist;
         let cos_i = n.dot(dir);
-        let cos_j = -self.mesh.patches[j].normal.dot(dir);
+        let cos_j = -em.normal.dot(dir);
         if cos_i <= 0.0 || cos_j <= 0.0 {
             return None;
         }
@@ -57,7 +63,7 @@ impl<I: Intersector> Kernel<'_, I> {
             Rgb::ZERO
         };
         Some(Shadow {
-            e_g: self.sol.e[j] * g,
+            e_g: em.e * g,
             cos_i: f64::from(cos_i),
             cos_j: f64::from(cos_j),
             dist: f64::from(dist),
@@ -76,8 +82,9 @@ impl<I: Intersector> Kernel<'_, I> {
         (n_l, n_c): (f64, f64),
     ) -> (Rgb, usize, bool) {
         let j = self.emitters.patches[e];
-        let area = self.mesh.patches[j].area;
-        let shadow = self.direct(from, j, y);
+        let em = &self.emitters.at[e];
+        let area = em.area;
+        let shadow = self.direct(from, (j, em), y);
         let cast = shadow.is_some();
         let (c, mis) = shadow.map_or((Rgb::ZERO, 0.0), |sh| {
             let geometry = (sh.cos_i, sh.cos_j, sh.dist);
@@ -108,7 +115,7 @@ impl<I: Intersector> Kernel<'_, I> {
             let from = spot.origin(u, v);
             // Stratified choice of the emitter, then a point on it from the rest of `s`.
             let (e, mass, s2) = self.emitters.pick(&split.draw, f64::from(s));
-            let y = self.emitters.points[e].at(s2, t);
+            let y = self.emitters.at[e].points.at(s2, t);
             let (val, j, cast) = self.light_sample(&from, (e, mass), y, (split.nl, split.nc));
             g.rays += u64::from(cast);
             m.push(scalar(spot.rho * val));

@@ -77,8 +77,8 @@ pub(crate) struct Emitters {
     /// The emitting patches, ascending (a back twin emits from the back of its surface).
     pub patches: Vec<usize>,
     cdf: Vec<f64>,
-    /// Uniform points on each, in the order of `patches`.
-    pub points: Vec<PatchPoints>,
+    /// What a light sample reads of each, in the order of `patches`.
+    pub at: Vec<Emitter>,
     /// Σ E·A (scalar W).
     pub power: f64,
     /// The tree: every node a contiguous stretch of `order`, the halves after their parent.
@@ -99,6 +99,15 @@ pub(crate) struct Emitters {
 #[derive(Clone, Debug)]
 pub(crate) struct Draw {
     local: Option<Cut>,
+}
+
+/// What a light sample reads of one emitting patch (uniform points on it, its normal, area
+/// and exitance E), held together: in four arrays, each cost a cache miss per light sample.
+pub(crate) struct Emitter {
+    pub points: PatchPoints,
+    pub normal: Vec3,
+    pub area: f64,
+    pub e: Rgb,
 }
 
 /// A receiver's cut: nodes of the tree covering every emitter that can light it, each once,
@@ -160,7 +169,14 @@ impl Emitters {
         let roots = tree.roots();
         let nodes = tree.nodes;
         Emitters {
-            points: patches.iter().map(|&j| PatchPoints::new(mesh, j)).collect(),
+            at: (patches.iter())
+                .map(|&j| Emitter {
+                    points: PatchPoints::new(mesh, j),
+                    normal: mesh.patches[j].normal,
+                    area: mesh.patches[j].area,
+                    e: e[j],
+                })
+                .collect(),
             patches,
             cdf,
             power,
@@ -614,7 +630,7 @@ mod tests {
             patches: vec![3, 5, 8],
             within: cdf.clone(),
             cdf,
-            points: Vec::new(),
+            at: Vec::new(),
             power: acc,
             nodes,
             roots: vec![4],

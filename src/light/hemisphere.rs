@@ -265,8 +265,8 @@ impl<I: Intersector> Kernel<'_, I> {
         } else {
             self.emitters.pick(&power, ((s - a) / (1.0 - a)).min(1.0))
         };
-        let j = self.emitters.patches[e];
-        let w_e = scalar(self.sol.e[j]) * self.mesh.patches[j].area;
+        let em = &self.emitters.at[e];
+        let w_e = scalar(em.e) * em.area;
         let mass = (followed_draws(near, &power).iter())
             .map(|&(d, share)| share * self.emitters.mass(d, e, w_e))
             .sum();
@@ -325,7 +325,7 @@ impl<I: Intersector> Kernel<'_, I> {
         // One light sample.
         if nl > 0.0 {
             let (e, mass) = self.followed_pick(near_draw, rng.gen());
-            let yj = self.emitters.points[e].at(rng.gen(), rng.gen());
+            let yj = self.emitters.at[e].points.at(rng.gen(), rng.gen());
             let (v, j, cast) = self.light_sample(&from, (e, mass), yj, (1.0, 1.0));
             if cast {
                 acc.rays += 1;
