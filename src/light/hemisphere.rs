@@ -145,10 +145,7 @@ impl<I: Intersector> Kernel<'_, I> {
                 let w = match self.emitters.index_of(r).filter(|_| n_l > 0.0) {
                     Some(ei) => {
                         let cos_i = f64::from(n.dot(dir));
-                        let w_e = scalar(e) * p.area;
-                        let mass = (draws.iter())
-                            .map(|&(d, share)| share * self.emitters.mass(d, ei, w_e))
-                            .sum();
+                        let mass = self.mixture_mass(draws, ei, scalar(e) * p.area);
                         Emitters::weight(mass, p.area, (cos_i, cos_r, f64::from(t)), n_l, n_c)
                     }
                     None => 0.0,
@@ -250,27 +247,29 @@ impl<I: Intersector> Kernel<'_, I> {
         self.followed(r, y, depth, near_draw, rng)
     }
 
-    /// A followed point's emitter for the number `s` ∈ [0, 1), and its probability: by power
-    /// alone when the gather draws by power; else from the mixture of the gathering point's
-    /// cut ([`FOLLOWED_NEAR`] of it) and the draw by power ([`followed_draws`]).
-    fn followed_pick(&self, near: &Draw, s: f64) -> (usize, f64) {
-        let power = Draw::by_power();
-        if !near.is_local() {
-            let (e, mass, _) = self.emitters.pick(&power, s);
+    /// A followed point's emitter for the number `s` ∈ [0, 1), drawn from `mix`
+    /// ([`followed_draws`]: one draw, or the gathering point's cut then the draw by power),
+    /// and its probability under the mixture.
+    fn followed_pick(&self, mix: &[(&Draw, f64)], s: f64) -> (usize, f64) {
+        let [(near, a), (power, _)] = mix else {
+            let (e, mass, _) = self.emitters.pick(mix[0].0, s);
             return (e, mass);
-        }
-        let a = FOLLOWED_NEAR;
-        let (e, _, _) = if s < a {
+        };
+        let (e, _, _) = if s < *a {
             self.emitters.pick(near, s / a)
         } else {
-            self.emitters.pick(&power, ((s - a) / (1.0 - a)).min(1.0))
+            self.emitters.pick(power, ((s - a) / (1.0 - a)).min(1.0))
         };
         let em = &self.emitters.at[e];
-        let w_e = scalar(em.e) * em.area;
-        let mass = (followed_draws(near, &power).iter())
+        (e, self.mixture_mass(mix, e, scalar(em.e) * em.area))
+    }
+
+    /// The probability that the mixture `draws` (each draw at its share) picks emitter `e` of
+    /// power `w_e`.
+    fn mixture_mass(&self, draws: &[(&Draw, f64)], e: usize, w_e: f64) -> f64 {
+        (draws.iter())
             .map(|&(d, share)| share * self.emitters.mass(d, e, w_e))
-            .sum();
-        (e, mass)
+            .sum()
     }
 
     /// What the solution says side `r` reflects: B_r − E_r, and per channel the channel's B
@@ -324,7 +323,7 @@ impl<I: Intersector> Kernel<'_, I> {
         let mix = followed_draws(near_draw, &by_power);
         // One light sample.
         if nl > 0.0 {
-            let (e, mass) = self.followed_pick(near_draw, rng.gen());
+            let (e, mass) = self.followed_pick(&mix, rng.gen());
             let yj = self.emitters.at[e].points.at(rng.gen(), rng.gen());
             let (v, j, cast) = self.light_sample(&from, (e, mass), yj, (1.0, 1.0));
             if cast {

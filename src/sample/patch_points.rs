@@ -11,7 +11,7 @@ use smallvec::SmallVec;
 /// then a uniform point in it. Built once per chunk of rays, so no work per ray but the draw.
 /// The fan of a triangle or a quadrilateral is held inline: the emitters' points are read at
 /// random by every light sample, and a fan on the heap cost a second cache miss each
-/// (docs/results/pipeline-1m.md).
+/// (docs/results/gather-building.md).
 pub struct PatchPoints {
     apex: Vec3,
     /// (b, c, cumulative area) of each fan triangle (apex, b, c).
