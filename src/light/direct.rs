@@ -1,6 +1,6 @@
 //! Direct light from the emitting patches: shadow rays from a point to points drawn on the
 //! emitters by what they can give it, or by power ([`super::emitters`]), each sample E_j·cosθ_i·cosθ_j/(π r²) divided by
-//! its density and counted at its MIS weight against the hemisphere rays (the balance
+//! its density and counted at its MIS weight against the hemisphere rays (the power
 //! heuristic, `Emitters::weight`).
 
 use super::emitters::{Emitter, Emitters};

@@ -1,6 +1,6 @@
-//! The emitting patches as light samples are drawn from them, and the balance heuristic's
+//! The emitting patches as light samples are drawn from them, and the power heuristic's
 //! weight of such a sample against a hemisphere ray for the same direction (Veach & Guibas,
-//! *Optimally Combining Sampling Techniques for Monte Carlo Rendering*, SIGGRAPH 1995, Sec. 3).
+//! *Optimally Combining Sampling Techniques for Monte Carlo Rendering*, SIGGRAPH 1995, Sec. 4).
 //!
 //! **Two ways to draw an emitter.** By power alone (`Draw::by_power`): a patch j chosen in
 //! proportion to E_j·A_j (a CDF over the emitting patches, walked with a stratified number),
@@ -20,13 +20,11 @@
 //! samples at all. With no more emitting patches than [`CLUSTERS`], each is its own node of
 //! every cut.
 //!
-//! Why the tree: a building has thousands of lamps, and the flat list of 128 clusters it
-//! replaces held, on the generated million-patch building (16,774 emitting patches of 2,809
-//! lamps), 131 patches of some twenty lamps each, drawn by power within, so most of a
-//! receiver's light samples went to lamps in other rooms. A cut draws the lamps near the
-//! receiver one by one: on the generated 100 k-patch building (1,516 emitting patches) the
-//! final gather's estimate fell from 3.61 % to 2.93 %, on the million-patch one from 4.12 % to
-//! 3.60 % (docs/results/pipeline-1m.md).
+//! Why the tree: a building has thousands of lamps; the flat list of 128 clusters it replaced
+//! held some twenty lamps each on the generated million-patch building, drawn by power within,
+//! so most light samples went to other rooms. A cut draws the lamps near the receiver one by
+//! one: the final gather's estimate fell from 3.61 to 2.93 % on the 100 k-patch building, from
+//! 4.12 to 3.60 % on the million-patch one (docs/results/pipeline-1m.md).
 //!
 //! Why: a luminaire modelled as a closed box or a thin panel with every face emitting (as CAD
 //! and glTF exports write them) sends half its power away from a ceiling 0.3 m above it, and
@@ -365,13 +363,13 @@ impl Emitters {
         }
     }
 
-    /// The balance heuristic's weight of a light sample of an emitter picked with probability
-    /// `mass`, of area `area`, against a hemisphere ray for the same direction: both
-    /// strategies see the emitter, each counts it with its share n·p / (n_l·p_l + n_c·p_c),
-    /// the densities in solid angle. The light sample's p_l = (mass / A_j)·r²/cos θ_j, the
-    /// hemisphere ray's p_c = cos θ_i / π. So a point beside a big emitter (where
-    /// r²/cos θ_j → 0 and light samples blow up) takes that light from its hemisphere rays,
-    /// and a small bright lamp far away from its light samples.
+    /// The power heuristic's weight (β = 2) of a light sample of an emitter picked with
+    /// probability `mass`, of area `area`, against a hemisphere ray for the same direction:
+    /// each counts it with its share (n·p)² / ((n_l·p_l)² + (n_c·p_c)²), the densities in solid
+    /// angle: p_l = (mass / A_j)·r²/cos θ_j, p_c = cos θ_i / π. So a point beside a big emitter
+    /// (r²/cos θ_j → 0: light samples blow up) takes that light from its hemisphere rays, a
+    /// small bright lamp far away from its light samples; the squares give a direction more
+    /// nearly all to the strategy that samples it well (docs/results/ray-path.md).
     pub fn weight(
         mass: f64,
         area: f64,
@@ -382,10 +380,11 @@ impl Emitters {
         let p_l = mass / area.max(f64::MIN_POSITIVE) * dist * dist / cos_j.max(1e-12);
         let p_c = cos_i.max(0.0) / std::f64::consts::PI;
         let (a, b) = (n_l * p_l, n_c * p_c);
-        if a + b > 0.0 {
-            a / (a + b)
-        } else {
-            1.0
+        // a² / (a² + b²), written so that neither square overflows.
+        match (a > 0.0, b > 0.0) {
+            (true, _) => 1.0 / (1.0 + (b / a).powi(2)),
+            (false, true) => 0.0,
+            (false, false) => 1.0,
         }
     }
 }
@@ -777,16 +776,18 @@ mod tests {
         assert!(em.draw_for(&above).is_none());
     }
 
-    /// The balance heuristic: a light sample's and a hemisphere ray's weights for one
-    /// direction add up to one.
+    /// The power heuristic: a light sample's and a hemisphere ray's weights for one
+    /// direction add up to one, each its strategy's (n·p)² over the sum of both.
     #[test]
     fn the_weights_of_a_path_add_up_to_one() {
         let (mass, area) = (0.25, 0.5);
         let w = Emitters::weight(mass, area, (0.7, 0.4, 1.5), 8.0, 24.0);
-        assert!(w > 0.0 && w < 1.0, "{w}");
         let p_l = mass / area * 1.5 * 1.5 / 0.4;
         let p_c = 0.7 / std::f64::consts::PI;
-        assert!((w - 8.0 * p_l / (8.0 * p_l + 24.0 * p_c)).abs() < 1e-12);
+        let (a, b) = ((8.0 * p_l).powi(2), (24.0 * p_c).powi(2));
+        assert!((w - a / (a + b)).abs() < 1e-12);
+        let tiny = Emitters::weight(1.0, 1e-300, (0.7, 0.4, 1.5), 8.0, 24.0);
+        assert_eq!(tiny, 1.0, "a tiny emitter's weight does not overflow");
         assert_eq!(Emitters::weight(mass, area, (0.0, 0.4, 1.5), 0.0, 1.0), 1.0);
     }
 

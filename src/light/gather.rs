@@ -103,7 +103,7 @@ impl Split {
             (LightParts::Direct, false, false) => (0, 0),
         };
         let grid = PolarGrid::for_samples(rays_wanted.saturating_sub(direct + n_sun).max(2) as f64);
-        // The MIS weights (balance heuristic, by the counts of light and hemisphere samples).
+        // The MIS weights (power heuristic, by the counts of light and hemisphere samples).
         // Split in two parts gathered apart, both weigh as if by equal counts (the split of
         // `All` without a sun), so that the two weights of a path still add up to one: the
         // light samples of `Direct` and the hemisphere rays of `Indirect` share each

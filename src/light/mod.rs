@@ -25,7 +25,7 @@
 //!   its side reflects: docs/design.md §9). With cosine-weighted directions the irradiance is
 //!   the plain mean of what the rays return.
 //!
-//! **Multiple importance sampling** (the balance heuristic, Veach & Guibas 1995): a hemisphere
+//! **Multiple importance sampling** (the power heuristic, Veach & Guibas 1995): a hemisphere
 //! ray that meets an emitter's emitting side also counts its E at its MIS weight, and a light
 //! sample counts at its own, so a point beside a big emitter (where 1/r² makes light samples
 //! heavy-tailed) takes that light from its hemisphere rays, and a small bright lamp far away
