@@ -43,8 +43,8 @@ use glam::Vec3;
 pub const CLUSTERS: usize = 128;
 
 /// The share of a receiver's light samples drawn by power among the emitters that can light
-/// it, whatever the estimate of their contributions says.
-pub const DEFENSIVE: f64 = 0.2;
+/// it, whatever the estimate of their contributions says (docs/results/ray-path.md).
+pub const DEFENSIVE: f64 = 0.05;
 
 /// One node of the emitters' tree: the emitters `order[start..end]`.
 #[derive(Clone, Debug)]
