@@ -1,6 +1,6 @@
 //! The emitting patches as light samples are drawn from them, and the power heuristic's
 //! weight of such a sample against a hemisphere ray for the same direction (Veach & Guibas,
-//! *Optimally Combining Sampling Techniques for Monte Carlo Rendering*, SIGGRAPH 1995, Sec. 4).
+//! *Optimally Combining Sampling Techniques for Monte Carlo Rendering*, SIGGRAPH 1995).
 //!
 //! **Two ways to draw an emitter.** By power alone (`Draw::by_power`): a patch j chosen in
 //! proportion to E_j·A_j (a CDF over the emitting patches, walked with a stratified number),
