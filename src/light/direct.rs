@@ -3,7 +3,7 @@
 //! its density and counted at its MIS weight against the hemisphere rays (the power
 //! heuristic, `Emitters::weight`).
 
-use super::emitters::{Emitter, Emitters};
+use super::emitters::{Emitter, Emitters, Learned};
 use super::gather::{latin, stratified_var, Gathered, Split, Spot};
 use super::{scalar, Kernel, Origin, Rgb};
 use crate::intersect::{Intersector, Ray};
@@ -103,6 +103,7 @@ impl<I: Intersector> Kernel<'_, I> {
         spot: &Spot,
         split: &Split,
         g: &mut Gathered,
+        mut learned: Option<&mut Learned>,
         rng: &mut R,
     ) {
         let n = split.direct;
@@ -117,6 +118,11 @@ impl<I: Intersector> Kernel<'_, I> {
             let (e, mass, s2) = self.emitters.pick(&split.draw, f64::from(s));
             let y = self.emitters.at[e].points.at(s2, t);
             let (val, j, cast) = self.light_sample(&from, (e, mass), y, (split.nl, split.nc));
+            if let Some(l) = learned.as_deref_mut() {
+                if let Some(node) = self.emitters.node_at(&split.draw, f64::from(s)) {
+                    l.record(node, scalar(val) > 0.0);
+                }
+            }
             g.rays += u64::from(cast);
             m.push(scalar(spot.rho * val));
             sum += val;

@@ -33,10 +33,14 @@
 //! each (docs/results/converted-models.md). Within a node of the cut, patches are drawn by
 //! power.
 
+mod learn;
+
 use super::{scalar, Rgb};
+use crate::mesh::spatial::{facing_class, space_order};
 use crate::mesh::Mesh;
 use crate::sample::PatchPoints;
 use glam::Vec3;
+pub(crate) use learn::Learned;
 
 /// At most this many nodes of the emitters' tree in a receiver's cut (each emitting patch is
 /// its own node of the cut when there are no more emitting patches than this).
@@ -503,54 +507,14 @@ fn contribution(c: &Cluster, r: &Receiver) -> f64 {
     (c.power * cos_i * cos_j / (std::f64::consts::PI * d2)).min(c.e_max)
 }
 
-/// The six axis facings, and 6 for any other: clusters never mix them.
-fn facing_class(n: Vec3) -> u8 {
-    let a = n.abs();
-    let (axis, v) = if a.x >= a.y && a.x >= a.z {
-        (0, n.x)
-    } else if a.y >= a.z {
-        (1, n.y)
-    } else {
-        (2, n.z)
-    };
-    if a.max_element() < 1.0 - 1e-4 {
-        6
-    } else {
-        axis * 2 + u8::from(v < 0.0)
-    }
-}
-
 /// The emitters (indices into `patches`) in cluster order: by facing, then along the Morton
-/// curve of their centres in the emitters' bounding box (so a chunk of the order is a
-/// compact group). When each is its own cluster the order is theirs.
+/// curve of their centres (`crate::mesh::spatial`: a chunk of the order is a compact group).
+/// When each is its own cluster the order is theirs.
 fn cluster_order(mesh: &Mesh, patches: &[usize]) -> Vec<u32> {
-    let mut order: Vec<u32> = (0..patches.len() as u32).collect();
     if patches.len() <= CLUSTERS {
-        return order;
+        return (0..patches.len() as u32).collect();
     }
-    let centre = |e: u32| mesh.patches[patches[e as usize]].centre;
-    let (lo, hi) = order.iter().fold(
-        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-        |(lo, hi), &e| (lo.min(centre(e)), hi.max(centre(e))),
-    );
-    let size = (hi - lo).max(Vec3::splat(1e-6));
-    let key = |e: u32| {
-        let q = ((centre(e) - lo) / size * 1023.0).clamp(Vec3::ZERO, Vec3::splat(1023.0));
-        let m = morton(q.x as u32) | (morton(q.y as u32) << 1) | (morton(q.z as u32) << 2);
-        (facing_class(mesh.patches[patches[e as usize]].normal), m, e)
-    };
-    order.sort_by_key(|&e| key(e));
-    order
-}
-
-/// The bits of a 10-bit `v` spread to every third bit.
-fn morton(v: u32) -> u32 {
-    let mut x = v & 0x3ff;
-    x = (x | (x << 16)) & 0x0300_00ff;
-    x = (x | (x << 8)) & 0x0300_f00f;
-    x = (x | (x << 4)) & 0x030c_30c3;
-    x = (x | (x << 2)) & 0x0924_9249;
-    x
+    space_order(mesh, patches)
 }
 
 /// The cluster of the emitters `members` (indices into `patches`), `span` in the order.
@@ -789,12 +753,5 @@ mod tests {
         let tiny = Emitters::weight(1.0, 1e-300, (0.7, 0.4, 1.5), 8.0, 24.0);
         assert_eq!(tiny, 1.0, "a tiny emitter's weight does not overflow");
         assert_eq!(Emitters::weight(mass, area, (0.0, 0.4, 1.5), 0.0, 1.0), 1.0);
-    }
-
-    #[test]
-    fn morton_interleaves_bits() {
-        assert_eq!(morton(0b1), 0b1);
-        assert_eq!(morton(0b11), 0b1001);
-        assert_eq!(morton(0x3ff), 0x0924_9249);
     }
 }

@@ -4,7 +4,7 @@
 //! rays shared out between them and their estimates combined by multiple importance sampling
 //! (see the module notes of [`super`]); with the variance of its mean, from the strata.
 
-use super::emitters::{Draw, Receiver};
+use super::emitters::{Draw, Learned, Receiver};
 use super::{Kernel, Origin, Rgb};
 use crate::intersect::Intersector;
 use crate::sample::polar::PolarGrid;
@@ -128,6 +128,19 @@ impl<I: Intersector> Kernel<'_, I> {
     /// The gather at `spot` that `ask` asks for: the emitters' light samples, the sun's, then
     /// the hemisphere rays, in that order (so the random numbers are drawn in that order).
     pub(crate) fn gather_at<R: Rng>(&self, spot: &Spot, ask: Ask, rng: &mut R) -> Gathered {
+        self.gather_learning(spot, ask, None, rng)
+    }
+
+    /// [`Self::gather_at`], its cut's draw weighed by what the gathers before it on the same
+    /// surface found (`learned`, [`super::emitters::Learned`]), and what its own light samples
+    /// find added to it.
+    pub(crate) fn gather_learning<R: Rng>(
+        &self,
+        spot: &Spot,
+        ask: Ask,
+        mut learned: Option<&mut Learned>,
+        rng: &mut R,
+    ) -> Gathered {
         let mut g = Gathered {
             h: Rgb::ZERO,
             ch: vec![Rgb::ZERO; self.sol.channels.len()],
@@ -140,13 +153,18 @@ impl<I: Intersector> Kernel<'_, I> {
         // (`LightParts`), by power, so that the parts' MIS weights still add up to one.
         let draw = match (lamps, ask.parts) {
             (false, _) => None,
-            (true, LightParts::All) => self.emitters.draw_for(&self.receiver(spot)),
+            (true, LightParts::All) => {
+                (self.emitters.draw_for(&self.receiver(spot))).map(|d| match learned.as_deref() {
+                    Some(l) => self.emitters.learned(d, l),
+                    None => d,
+                })
+            }
             (true, _) => Some(Draw::by_power()),
         };
         let sun = self.sky.sun();
         let split = Split::new(ask.parts, draw, sun.is_some(), ask.rays);
         if split.direct > 0 {
-            self.direct_part(spot, &split, &mut g, rng);
+            self.direct_part(spot, &split, &mut g, learned.as_deref_mut(), rng);
         }
         if let Some(sun) = sun.filter(|_| split.sun > 0) {
             self.sun_part(spot, sun, split.sun, &mut g, rng);
@@ -156,6 +174,9 @@ impl<I: Intersector> Kernel<'_, I> {
         }
         if ask.parts != LightParts::Direct {
             self.hemisphere_part(spot, &split, &mut g, rng);
+        }
+        if let Some(l) = learned {
+            l.settle();
         }
         g
     }

@@ -11,8 +11,9 @@
 //! - **Direct light** by sampling the emitters explicitly ([`emitters`], [`direct`]): an
 //!   emitting patch j drawn with probability P_j — by an estimate of the irradiance its
 //!   cluster of emitters gives the receiver, mixed with a share by power E_j·A_j (a CDF,
-//!   stratified; none where no emitter can light the receiver) — a point y uniform on it, a
-//!   shadow ray from x. The ray must reach
+//!   stratified; none where no emitter can light the receiver; in the final gather weighed by
+//!   which emitters the neighbouring patches gathered before it saw, `emitters::Learned`) — a
+//!   point y uniform on it, a shadow ray from x. The ray must reach
 //!   j's emitting side (a one-sided emitter emits from its front only; a back twin from the
 //!   back of its surface, `Mesh::receiver`) with nothing before it; the sample is
 //!   E_j·cosθ_i·cosθ_j/(π r²) / p(y), p(y) = P_j / A_j.

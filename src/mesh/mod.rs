@@ -20,6 +20,7 @@
 //! | `hidden.rs`    | the sides no light can reach (what was found)  |
 //! | `contact.rs`   | faces lying on faces that face them            |
 //! | `near_lights.rs` | patches cut finer where a light is close     |
+//! | `spatial.rs`   | patches in space order (facing, Morton curve)  |
 
 mod contact;
 mod hidden;
@@ -29,6 +30,7 @@ pub use hidden::Hidden;
 mod classify;
 mod pieces;
 mod sides;
+pub mod spatial;
 mod subdivide;
 #[cfg(test)]
 mod tests;

@@ -54,8 +54,10 @@
 use super::estimate::{self, ErrorMetrics, Parts};
 use super::{rng_for, scalar, LightChannel, Solution, Stream, TracePoint};
 use crate::intersect::Intersector;
+use crate::light::emitters::Learned;
 use crate::light::gather::{Ask, Gathered, Spot};
 use crate::light::{self, emission_and_reflectance, Kernel, LightParts, Rgb, Solved};
+use crate::mesh::spatial::{facing_class, space_order};
 use crate::mesh::Mesh;
 use crate::sample::PatchPoints;
 use crate::scene::Material;
@@ -92,9 +94,8 @@ pub const BIAS_Z: f64 = 4.0;
 fn gather_patch<I: Intersector>(
     kernel: &Kernel<'_, I>,
     seed: u64,
-    i: usize,
-    rays: usize,
-    round: u64,
+    (i, rays, round): (usize, usize, u64),
+    learned: &mut Learned,
 ) -> Gathered {
     let points = PatchPoints::new(kernel.mesh, i);
     let mut rng = rng_for(seed, Stream::Regather(round), i as u64);
@@ -111,7 +112,55 @@ fn gather_patch<I: Intersector>(
         lights: true,
         parts: LightParts::All,
     };
-    kernel.gather_at(&spot, ask, &mut rng)
+    kernel.gather_learning(&spot, ask, Some(learned), &mut rng)
+}
+
+/// Runs of at most this many neighbouring patches learn from each other's light samples
+/// ([`Learned`]).
+const LEARNING_RUN: usize = 256;
+
+/// Gathers `todo[k]` with `rays(k)` rays (none when 0) in round `round`: in parallel over runs
+/// of neighbouring patches facing one way ([`crate::mesh::spatial::space_order`], so the runs
+/// do not depend on the order of the model's faces), each patch of a run learning from those
+/// before it which lamps it sees ([`Learned`]). Results in the order of `todo`.
+fn gather_runs<I: Intersector>(
+    kernel: &Kernel<'_, I>,
+    seed: u64,
+    todo: &[usize],
+    rays: impl Fn(usize) -> usize + Sync,
+    round: u64,
+) -> Vec<Option<Gathered>> {
+    let mesh = kernel.mesh;
+    let order = space_order(mesh, todo);
+    let class = |at: usize| facing_class(mesh.patches[todo[order[at] as usize]].normal);
+    let mut runs = Vec::new();
+    let mut start = 0;
+    for at in 1..=order.len() {
+        if at == order.len() || at - start == LEARNING_RUN || class(at) != class(start) {
+            runs.push(&order[start..at]);
+            start = at;
+        }
+    }
+    let got: Vec<Vec<(u32, Option<Gathered>)>> = runs
+        .into_par_iter()
+        .map(|run| {
+            let mut learned = Learned::default();
+            (run.iter())
+                .map(|&k| {
+                    let r = rays(k as usize);
+                    let i = todo[k as usize];
+                    let g =
+                        (r > 0).then(|| gather_patch(kernel, seed, (i, r, round), &mut learned));
+                    (k, g)
+                })
+                .collect()
+        })
+        .collect();
+    let mut out = vec![None; todo.len()];
+    for (k, g) in got.into_iter().flatten() {
+        out[k as usize] = g;
+    }
+    out
 }
 
 /// The shooting's estimate of each patch, from the books at the end of the shooting.
@@ -399,9 +448,9 @@ fn first_round<I: Intersector>(
     let todo: Vec<usize> = (0..mesh.patches.len())
         .filter(|&i| !faces_void(i) && !hidden(i) && light::scalar(rho[i]) > 0.0)
         .collect();
-    let got: Vec<Gathered> = todo
-        .par_iter()
-        .map(|&i| gather_patch(kernel, seed, i, rays, 0))
+    let got: Vec<Gathered> = gather_runs(kernel, seed, &todo, |_| rays, 0)
+        .into_iter()
+        .map(|g| g.expect("every patch asks rays"))
         .collect();
     Gathers {
         asked: vec![rays; todo.len()],
@@ -417,11 +466,8 @@ fn regather<I: Intersector>(kernel: &Kernel<'_, I>, seed: u64, more: Regather) -
     let Regather { mut prior, extra } = more;
     prior.rounds += 1;
     let round = prior.rounds;
-    let fresh: Vec<Option<Gathered>> = prior
-        .todo
-        .par_iter()
-        .map(|&i| (extra[i] > 0).then(|| gather_patch(kernel, seed, i, extra[i], round)))
-        .collect();
+    let todo = &prior.todo;
+    let fresh = gather_runs(kernel, seed, todo, |k| extra[todo[k]], round);
     for (k, g2) in fresh.into_iter().enumerate() {
         if let Some(g2) = g2 {
             let i = prior.todo[k];

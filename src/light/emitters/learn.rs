@@ -1,0 +1,161 @@
+//! Light samples that learn what a surface sees. A receiver's cut (the parent module) weighs
+//! each node by the irradiance it could give the receiver if nothing stood between them; it
+//! knows nothing of walls and slabs. On the generated 100 k-patch building a floor patch's
+//! light samples went 79 % (median) to lamps it cannot see — those of the rooms beside it and
+//! of the storey above, as near as its own — and a floor's direct light was the noisiest part
+//! of its gather (docs/results/ray-path.md).
+//!
+//! Neighbouring patches of one surface see the same lamps, so the gathers of a surface's
+//! patches, made one after another, pass on what they found ([`Learned`]): per node of the
+//! emitters' tree, how many of its light samples reached it. The next patch draws each node of
+//! its cut by the cut's probability times the share of that node's samples seen so far,
+//! v = (seen + ½)/(tried + 1) (½ for a node not tried yet), mixed with [`KEEP`] of the cut's
+//! own draw, so that every emitter the cut can draw stays drawn (what a node's samples found
+//! on one patch need not hold on the next: a shadow's edge runs across a floor).
+//!
+//! Unbiased: a patch's draw is fixed before its own samples are drawn (it depends on other
+//! patches' random numbers only), and its density is used throughout — for the samples, for
+//! the hemisphere rays' MIS weights and for the followed points' light samples. Reproducible:
+//! which patches learn from which is fixed by the order of the patches, not by the threads.
+
+use super::{Cut, Draw, Emitters};
+
+/// The share of a learned draw that stays the cut's own (see the module notes): a node found
+/// dark is still drawn at least this share of what the cut gives it.
+pub const KEEP: f64 = 0.25;
+
+/// Counts older than this many samples of a node are halved, so what nearer patches found
+/// weighs more than what the first patches of a long surface found.
+const MEMORY: f32 = 64.0;
+
+/// What the gathers made so far on one surface found: per node of the emitters' tree, the
+/// light samples seen (reaching the emitter) and tried, sorted by node.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Learned {
+    counts: Vec<(u32, f32, f32)>,
+    /// This gather's samples, (node, seen), merged into `counts` by [`Learned::settle`].
+    fresh: Vec<(u32, bool)>,
+}
+
+impl Learned {
+    /// Notes a light sample of node `node`: whether it reached its emitter.
+    pub fn record(&mut self, node: u32, seen: bool) {
+        self.fresh.push((node, seen));
+    }
+
+    /// Merges this gather's samples into the counts (after the gather: the draw of a gather
+    /// never depends on its own samples).
+    pub fn settle(&mut self) {
+        if self.fresh.is_empty() {
+            return;
+        }
+        self.fresh.sort_unstable_by_key(|&(n, _)| n);
+        for &(node, seen) in &self.fresh {
+            let at = self.counts.partition_point(|&(n, _, _)| n < node);
+            if self.counts.get(at).is_none_or(|&(n, _, _)| n != node) {
+                self.counts.insert(at, (node, 0.0, 0.0));
+            }
+            let c = &mut self.counts[at];
+            c.1 += f32::from(u8::from(seen));
+            c.2 += 1.0;
+            if c.2 > MEMORY {
+                c.1 *= 0.5;
+                c.2 *= 0.5;
+            }
+        }
+        self.fresh.clear();
+    }
+
+    /// The share of node `node`'s samples seen so far: (seen + ½)/(tried + 1).
+    fn seen_share(&self, node: u32) -> f64 {
+        match self.counts.binary_search_by_key(&node, |&(n, _, _)| n) {
+            Ok(at) => {
+                let (_, seen, tried) = self.counts[at];
+                (f64::from(seen) + 0.5) / (f64::from(tried) + 1.0)
+            }
+            Err(_) => 0.5,
+        }
+    }
+}
+
+impl Emitters {
+    /// The node of the cut that `s` picks by `draw` (as [`Emitters::pick`] does); `None` for a
+    /// draw by power.
+    pub fn node_at(&self, draw: &Draw, s: f64) -> Option<u32> {
+        let cut = draw.local.as_ref()?;
+        let c = cut.cdf.partition_point(|&x| x <= s).min(cut.cdf.len() - 1);
+        Some(cut.nodes[c])
+    }
+
+    /// `draw` weighed by what `learned` found (module notes); a draw by power, or a cut none
+    /// of whose nodes has been tried, stays as it is.
+    pub fn learned(&self, draw: Draw, learned: &Learned) -> Draw {
+        let Some(cut) = draw.local.as_ref() else {
+            return draw;
+        };
+        if learned.counts.is_empty() {
+            return draw;
+        }
+        let mut lo = 0.0;
+        let mut p: Vec<f64> = Vec::with_capacity(cut.nodes.len());
+        let mut total = 0.0;
+        for (&n, &c) in cut.nodes.iter().zip(&cut.cdf) {
+            let q = (c - lo) * learned.seen_share(n);
+            lo = c;
+            p.push(q);
+            total += q;
+        }
+        if total <= 0.0 || !total.is_finite() {
+            return draw;
+        }
+        let mut lo = 0.0;
+        let mut acc = 0.0;
+        let mut cdf: Vec<f64> = (p.iter().zip(&cut.cdf))
+            .map(|(&q, &c)| {
+                acc += KEEP * (c - lo) + (1.0 - KEEP) * q / total;
+                lo = c;
+                acc
+            })
+            .collect();
+        *cdf.last_mut().expect("a cut is never empty") = 1.0;
+        Draw {
+            local: Some(Cut {
+                nodes: cut.nodes.clone(),
+                cdf,
+            }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A node whose samples were all dark is drawn at about KEEP of its share; one whose
+    /// samples were all seen takes the rest; the CDF still ends at exactly 1.
+    #[test]
+    fn a_dark_node_keeps_only_its_defensive_share() {
+        let draw = Draw {
+            local: Some(Cut {
+                nodes: vec![3, 7],
+                cdf: vec![0.5, 1.0],
+            }),
+        };
+        let mut l = Learned::default();
+        for _ in 0..200 {
+            l.record(3, false);
+            l.record(7, true);
+        }
+        l.settle();
+        assert!(l.counts.iter().all(|&(_, _, t)| t <= MEMORY));
+        // Emitters are not read by `learned` beyond the draw: an empty set will do.
+        let em = Emitters::new(&crate::mesh::Mesh::default(), &[]);
+        let d = em.learned(draw, &l);
+        let cdf = &d.local.as_ref().unwrap().cdf;
+        let dark = cdf[0];
+        assert!((dark - KEEP * 0.5).abs() < 0.01, "{dark}");
+        assert_eq!(cdf[1], 1.0);
+        assert_eq!(em.node_at(&d, 0.05), Some(3));
+        assert_eq!(em.node_at(&d, 0.5), Some(7));
+    }
+}
