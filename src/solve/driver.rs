@@ -196,7 +196,7 @@ fn gather_rays_within(
     let elapsed = start.elapsed().as_secs_f64();
     gather_rays_fitting(
         cfg,
-        cfg.gather_rays_per_patch(),
+        cfg.first_gather_rays(),
         patches,
         stats.rays as f64,
         elapsed,

@@ -10,8 +10,10 @@
 //! the mean of passes of C_1, C_2, … has the noise of one pass of C = 1/Σ(1/C_k). Nothing is
 //! thrown away, so error against time keeps falling like 1/√rays for as long as the run is let.
 //!
-//! **The first pass** is the plain solve, final gather included: when it already meets E (the
-//! project's scenes at the default 5 % do) the result is exactly `--error off`'s. Otherwise each
+//! **The first pass** is the plain solve, final gather included, sized for the gather to make
+//! the estimate: without `--tolerance` it shoots at 1.4·E
+//! ([`super::settings::TARGET_TOLERANCE`]) and gathers half the rays per patch
+//! ([`super::settings::FIRST_GATHER_SHARE`]); when it meets E it is the result. Otherwise each
 //! next pass is sized from the estimate: to reach E from e with R samples so far, about
 //! R·((e/E)^(1/p) − 1) more are needed, p the rate the estimate falls at (e ∝ R^−p). Pure
 //! sampling noise gives p = ½; where the gather's near paths or light still owed weigh in the
@@ -403,15 +405,16 @@ impl<'a, I: Intersector> Passes<'a, I> {
         let (cfg, target, r1) = (self.at.cfg, self.at.target, self.r1);
         while self.m.weighted_percent > target && !budget_stopped(&self.sols[self.sols.len() - 1]) {
             let so_far: f64 = self.sols.iter().map(samples).sum();
-            if cfg.error_max_factor.is_some_and(|f| so_far >= f * r1) {
+            let bound = cfg.error_bound(r1);
+            if bound.is_some_and(|b| so_far >= b) {
                 self.capped = true;
                 break;
             }
             let want =
                 so_far * ((self.m.weighted_percent / (AIM * target)).powf(1.0 / self.p) - 1.0);
             let mut rays = want.clamp(r1, 3.0 * so_far);
-            if let Some(f) = cfg.error_max_factor {
-                rays = rays.min((f * r1 - so_far).max(r1));
+            if let Some(b) = bound {
+                rays = rays.min((b - so_far).max(r1));
             }
             // A further gather round instead, when the model says it reaches the target for
             // fewer rays than the passes and their gathers would cast (module notes).
@@ -546,7 +549,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
         let cfg = self.at.cfg;
         let mut scale = (so_far + samples(sol)) / self.r1;
         if self.gather.is_some() {
-            let wanted = (cfg.gather_rays_per_patch() as f64 * scale).round() as usize;
+            let wanted = (cfg.first_gather_rays() as f64 * scale).round() as usize;
             let elapsed = self.at.start.elapsed().as_secs_f64();
             let cast = so_far + samples(sol);
             let np = self.at.mesh.patches.len();
@@ -568,7 +571,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
         more: Option<(final_gather::Gathers, &[usize])>,
     ) -> (Solution, ErrorMetrics, Base) {
         let (cfg, hooks) = (self.at.cfg, self.at.hooks);
-        let rays = (cfg.gather_rays_per_patch() as f64 * scale)
+        let rays = (cfg.first_gather_rays() as f64 * scale)
             .round()
             .min(super::settings::MAX_GATHER_RAYS as f64) as usize;
         let shooting = final_gather::Shooting {

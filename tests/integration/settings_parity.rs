@@ -329,6 +329,7 @@ fn help_names_the_library_defaults() {
     let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
     for needle in [
         format!("[default: {DEFAULT_TOLERANCE}; reference: {REFERENCE_TOLERANCE}]"),
+        format!("first pass at {TARGET_TOLERANCE}× the error target"),
         format!("[default: {DEFAULT_STOP}; reference: {REFERENCE_STOP:e}]"),
         format!("[default: {DEFAULT_SEED}]"),
         format!("[default: {DEFAULT_HEMICUBE_N}]"),

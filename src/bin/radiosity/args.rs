@@ -96,7 +96,9 @@ pub struct SamplingArgs {
     pub seed: Option<u64>,
     /// Relative sampling error wanted for a typical patch's radiosity. Sets the energy each ray
     /// carries (Sec. 2: rays in proportion to unshot energy): about patches/tolerance² rays in
-    /// all, so halving it costs 4× the rays [default: 0.05; reference: 0.005].
+    /// all, so halving it costs 4× the rays. Left out, a solve with an error target shoots its
+    /// first pass at 1.4× the error target, and its final gather makes the estimate
+    /// [default: 0.05; reference: 0.005].
     #[arg(long, allow_negative_numbers = true)]
     pub tolerance: Option<f64>,
     /// Energy per ray C in watts (overrides --tolerance).
@@ -127,7 +129,8 @@ pub struct SamplingArgs {
     #[arg(long, value_enum, default_value_t = OnOff::from(DEFAULT_FINAL_GATHER), value_name = "on|off")]
     pub final_gather: OnOff,
     /// Rays per gathered patch at the default tolerance, growing as 1/tolerance² with a finer
-    /// one (half to the lights, half over the hemisphere).
+    /// one (half to the lights, half over the hemisphere); with an error target the first
+    /// gather casts half of them, and further rounds add rays where the error is.
     #[arg(long, default_value_t = DEFAULT_GATHER_RAYS, value_name = "N")]
     pub gather_rays: usize,
 }
@@ -238,6 +241,7 @@ impl SolverArgs {
             switch_by: self.switch_by,
             ..self.sampling.over(SolveSettings::default())
         }
+        .with_target_tolerance(self.sampling.tolerance.is_some())
     }
 
     /// The settings of `radiosity solve`: without `--error`, the library's default error
@@ -245,7 +249,8 @@ impl SolverArgs {
     pub fn solve_settings(&self) -> SolveSettings {
         let s = self.settings();
         match self.error_target {
-            None => s.with_solve_default_error(),
+            None => (s.with_solve_default_error())
+                .with_target_tolerance(self.sampling.tolerance.is_some()),
             Some(_) => s,
         }
     }
