@@ -432,9 +432,15 @@ impl<'a, I: Intersector> Passes<'a, I> {
                 r1,
                 first_gather_rays: self.first_gather_rays,
             };
+            // The bound holds the gather rounds too: all rays cast, gathers included, stay
+            // within the bound's samples and the first pass's share of gather rays.
+            let cast = self.trace.last().map_or(so_far, |t| t.rays as f64);
+            let all_rays = bound.map(|b| b * (r1 + self.first_gather_rays) / r1);
+            let fits =
+                |pl: &final_gather::RegatherPlan| all_rays.is_none_or(|a| cast + pl.rays <= a);
             if let (Some(isect), Some(plan)) = (
                 self.gather,
-                plan.filter(|pl| passes.costs_more_than(pl.rays)),
+                plan.filter(|pl| passes.costs_more_than(pl.rays) && fits(pl)),
             ) {
                 if !self.regather(isect, &plan, so_far, on_trace) {
                     break;
