@@ -206,6 +206,12 @@ impl Emitters {
     /// `r`.
     pub fn draw_for(&self, r: &Receiver) -> Option<Draw> {
         let (nodes, est) = self.cut_for(r);
+        self.draw_of(nodes, est)
+    }
+
+    /// The draw of the cut `nodes` with the estimates `est` (all positive), as
+    /// [`Emitters::draw_for`] makes it.
+    fn draw_of(&self, nodes: Vec<u32>, est: Vec<f64>) -> Option<Draw> {
         let (mut total, mut reach) = (0.0, 0.0);
         for (&n, &w) in nodes.iter().zip(&est) {
             total += w;
@@ -661,12 +667,26 @@ mod tests {
         assert!(em.draw_for(&facing_away).is_none());
     }
 
-    /// A ceiling of 20 × 20 small lamps facing down, more than a cut holds: a receiver on the
-    /// floor draws from its cut of the tree, the probabilities `pick` reports are the ones
-    /// `mass` gives, they add up to one, and the lamp straight above is drawn far more often
-    /// than one across the room, which is still drawn (the defensive share).
-    #[test]
-    fn a_cut_of_many_lamps_draws_the_near_ones_one_by_one() {
+    /// A ceiling of `n` × `n` lamps 0.2 m across, 1 m apart, at z = 3, facing down.
+    pub(super) fn ceiling(n: usize) -> Vec<[Vec3; 4]> {
+        let mut quads = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let (x, y) = (i as f32, j as f32);
+                // Wound clockwise seen from above: facing down.
+                quads.push([
+                    Vec3::new(x, y, 3.0),
+                    Vec3::new(x, y + 0.2, 3.0),
+                    Vec3::new(x + 0.2, y + 0.2, 3.0),
+                    Vec3::new(x + 0.2, y, 3.0),
+                ]);
+            }
+        }
+        quads
+    }
+
+    /// A mesh of lamps (exitance 1, one patch each) on the quadrilaterals `quads`.
+    pub(super) fn lamps(quads: &[[Vec3; 4]]) -> Mesh {
         use crate::scene::{Material, Polygon, Scene};
         let mut scene = Scene {
             materials: vec![Material {
@@ -677,32 +697,32 @@ mod tests {
             }],
             ..Scene::default()
         };
-        for i in 0..20 {
-            for j in 0..20 {
-                let (x, y) = (i as f32, j as f32);
-                let base = scene.positions.len() as u32;
-                // Wound clockwise seen from above: facing down.
-                scene.positions.extend_from_slice(&[
-                    Vec3::new(x, y, 3.0),
-                    Vec3::new(x, y + 0.2, 3.0),
-                    Vec3::new(x + 0.2, y + 0.2, 3.0),
-                    Vec3::new(x + 0.2, y, 3.0),
-                ]);
-                scene.indices.extend(base..base + 4);
-                scene.polygons.push(Polygon {
-                    first: 4 * (20 * i + j),
-                    len: 4,
-                    material: 0,
-                    back_material: None,
-                });
-            }
+        for q in quads {
+            let base = scene.positions.len() as u32;
+            scene.positions.extend_from_slice(q);
+            scene.indices.extend(base..base + 4);
+            scene.polygons.push(Polygon {
+                first: base,
+                len: 4,
+                material: 0,
+                back_material: None,
+            });
         }
         let opts = crate::mesh::MeshOptions {
             patch_size: Some(1.0),
             uniform_patches: true,
             ..Default::default()
         };
-        let mesh = crate::mesh::build(&scene, &opts);
+        crate::mesh::build(&scene, &opts)
+    }
+
+    /// A ceiling of 20 × 20 small lamps facing down, more than a cut holds: a receiver on the
+    /// floor draws from its cut of the tree, the probabilities `pick` reports are the ones
+    /// `mass` gives, they add up to one, and the lamp straight above is drawn far more often
+    /// than one across the room, which is still drawn (the defensive share).
+    #[test]
+    fn a_cut_of_many_lamps_draws_the_near_ones_one_by_one() {
+        let mesh = lamps(&ceiling(20));
         assert_eq!(mesh.patches.len(), 400);
         let e = vec![Rgb::ONE; mesh.patches.len()];
         let em = Emitters::new(&mesh, &e);

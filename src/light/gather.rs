@@ -154,7 +154,13 @@ impl<I: Intersector> Kernel<'_, I> {
         let draw = match (lamps, ask.parts) {
             (false, _) => None,
             (true, LightParts::All) => {
-                (self.emitters.draw_for(&self.receiver(spot))).map(|d| match learned.as_deref() {
+                let r = self.receiver(spot);
+                let l = learned.as_deref();
+                let draw = match l.and_then(Learned::shared_cut) {
+                    Some(nodes) => self.emitters.draw_among(nodes, &r),
+                    None => self.emitters.draw_for(&r),
+                };
+                draw.map(|d| match l {
                     Some(l) => self.emitters.learned(d, l),
                     None => d,
                 })
@@ -183,6 +189,21 @@ impl<I: Intersector> Kernel<'_, I> {
 }
 
 impl<I> Kernel<'_, I> {
+    /// The gathers of `patches` (neighbours on one plane, facing one way, gathered next with
+    /// `learned`) share the shape of one cut of the emitters' tree ([`Learned::share_cut`]);
+    /// a single patch makes its own.
+    pub(crate) fn share_cut(&self, patches: &[usize], learned: &mut Learned) {
+        if patches.len() < 2 || self.emitters.is_empty() {
+            learned.share_cut(None);
+            return;
+        }
+        let parts: Vec<(Receiver, f32)> = (patches.iter())
+            .map(|&i| (self.patch_receiver(i), self.mesh.patches[i].area as f32))
+            .collect();
+        let nodes = self.emitters.cut_nodes(&Receiver::covering(&parts));
+        learned.share_cut(Some(nodes));
+    }
+
     /// The receiver a spot's emitters are weighed for: its patch (centre, normal and the
     /// distance to its farthest corner), or the sensor's point.
     fn receiver(&self, spot: &Spot) -> Receiver {

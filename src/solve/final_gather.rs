@@ -145,15 +145,22 @@ fn gather_runs<I: Intersector>(
         .into_par_iter()
         .map(|run| {
             let mut learned = Learned::default();
-            (run.iter())
-                .map(|&k| {
+            let mut out = Vec::with_capacity(run.len());
+            for group in shared_cuts(mesh, todo, run) {
+                let patches: Vec<usize> = (group.iter())
+                    .filter(|&&k| rays(k as usize) > 0)
+                    .map(|&k| todo[k as usize])
+                    .collect();
+                kernel.share_cut(&patches, &mut learned);
+                for &k in group {
                     let r = rays(k as usize);
                     let i = todo[k as usize];
                     let g =
                         (r > 0).then(|| gather_patch(kernel, seed, (i, r, round), &mut learned));
-                    (k, g)
-                })
-                .collect()
+                    out.push((k, g));
+                }
+            }
+            out
         })
         .collect();
     let mut out = vec![None; todo.len()];
@@ -161,6 +168,29 @@ fn gather_runs<I: Intersector>(
         out[k as usize] = g;
     }
     out
+}
+
+/// At most this many neighbouring patches of one polygon share the shape of a cut of the
+/// emitters' tree (`Learned::share_cut`).
+const SHARED_CUT: usize = 8;
+
+/// `run` (indices into `todo`) in groups that share a cut: consecutive patches of one
+/// polygon with one normal, at most [`SHARED_CUT`] of them.
+fn shared_cuts<'r>(mesh: &Mesh, todo: &[usize], run: &'r [u32]) -> Vec<&'r [u32]> {
+    let patch = |at: usize| &mesh.patches[todo[run[at] as usize]];
+    let mut groups = Vec::new();
+    let mut start = 0;
+    for at in 1..=run.len() {
+        if at == run.len()
+            || at - start == SHARED_CUT
+            || patch(at).polygon != patch(start).polygon
+            || patch(at).normal != patch(start).normal
+        {
+            groups.push(&run[start..at]);
+            start = at;
+        }
+    }
+    groups
 }
 
 /// The shooting's estimate of each patch, from the books at the end of the shooting.

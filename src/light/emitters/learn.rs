@@ -17,8 +17,18 @@
 //! patches' random numbers only), and its density is used throughout — for the samples, for
 //! the hemisphere rays' MIS weights and for the followed points' light samples. Reproducible:
 //! which patches learn from which is fixed by the order of the patches, not by the threads.
+//!
+//! A few neighbouring patches of one polygon also share the *shape* of their cut
+//! ([`Learned::share_cut`]): which nodes of the tree it holds, made once for a receiver that
+//! covers them all, each patch then weighing those nodes for itself
+//! ([`Emitters::draw_among`]). A node that can light none of a patch's points weighs nothing
+//! for it and is dropped; every node that can is in the shared cut, since the covering
+//! receiver's plane lies behind each patch's and its sphere holds each patch's: still
+//! unbiased, for a fraction of the cost of a cut of its own (the tree's nodes are searched
+//! once for the group).
 
-use super::{Cut, Draw, Emitters};
+use super::{contribution, Cut, Draw, Emitters, Receiver};
+use glam::Vec3;
 
 /// The share of a learned draw that stays the cut's own (see the module notes): a node found
 /// dark is still drawn at least this share of what the cut gives it.
@@ -35,6 +45,9 @@ pub(crate) struct Learned {
     counts: Vec<(u32, f32, f32)>,
     /// This gather's samples, (node, seen), merged into `counts` by [`Learned::settle`].
     fresh: Vec<(u32, bool)>,
+    /// The nodes of the cut the current neighbours share ([`Learned::share_cut`]); empty when
+    /// each patch makes its own.
+    shared: Vec<u32>,
 }
 
 impl Learned {
@@ -66,6 +79,17 @@ impl Learned {
         self.fresh.clear();
     }
 
+    /// The gathers that follow, until the next call, draw among the nodes of `nodes` (a cut
+    /// made for a receiver covering them all, [`Receiver::covering`]); none: each its own cut.
+    pub fn share_cut(&mut self, nodes: Option<Vec<u32>>) {
+        self.shared = nodes.unwrap_or_default();
+    }
+
+    /// The cut the current neighbours share, if any.
+    pub fn shared_cut(&self) -> Option<&[u32]> {
+        (!self.shared.is_empty()).then_some(&self.shared[..])
+    }
+
     /// The share of node `node`'s samples seen so far: (seen + ½)/(tried + 1).
     fn seen_share(&self, node: u32) -> f64 {
         match self.counts.binary_search_by_key(&node, |&(n, _, _)| n) {
@@ -78,7 +102,59 @@ impl Learned {
     }
 }
 
+impl Receiver {
+    /// A receiver covering `parts` (receivers of one plane's patches, with their areas): their
+    /// area-weighted centre, moved back along the normal to the hindmost of their centres, and
+    /// a sphere holding each part's. What no point of it can see, no point of theirs can.
+    pub fn covering(parts: &[(Receiver, f32)]) -> Receiver {
+        let normal = parts[0].0.normal;
+        let (mut sum, mut area) = (Vec3::ZERO, 0.0f32);
+        for (r, a) in parts {
+            sum += r.centre * *a;
+            area += *a;
+        }
+        let mean = if area > 0.0 {
+            sum / area
+        } else {
+            parts[0].0.centre
+        };
+        let back = (parts.iter())
+            .map(|(r, _)| normal.dot(r.centre))
+            .fold(f32::INFINITY, f32::min);
+        let centre = mean - normal * (normal.dot(mean) - back).max(0.0);
+        let radius = (parts.iter())
+            .map(|(r, _)| r.centre.distance(centre) + r.radius)
+            .fold(0.0f32, f32::max);
+        Receiver {
+            centre,
+            normal,
+            radius,
+        }
+    }
+}
+
 impl Emitters {
+    /// The nodes of `r`'s cut ([`Emitters::draw_for`]), to be shared by the patches `r`
+    /// covers ([`Learned::share_cut`]).
+    pub fn cut_nodes(&self, r: &Receiver) -> Vec<u32> {
+        self.cut_for(r).0
+    }
+
+    /// The draw of receiver `r` among the nodes of a shared cut, each weighed for `r` as its
+    /// own cut would weigh it; the nodes that can give `r` nothing dropped. `None` when none
+    /// can.
+    pub fn draw_among(&self, nodes: &[u32], r: &Receiver) -> Option<Draw> {
+        let (mut kept, mut est) = (Vec::with_capacity(nodes.len()), Vec::new());
+        for &n in nodes {
+            let w = contribution(&self.nodes[n as usize], r);
+            if w > 0.0 {
+                kept.push(n);
+                est.push(w);
+            }
+        }
+        self.draw_of(kept, est)
+    }
+
     /// The node of the cut that `s` picks by `draw` (as [`Emitters::pick`] does); `None` for a
     /// draw by power.
     pub fn node_at(&self, draw: &Draw, s: f64) -> Option<u32> {
@@ -130,6 +206,70 @@ impl Emitters {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::light::{scalar, Rgb};
+
+    /// Lamps facing down over a floor (a 12 × 12 grid at z = 3) and a column of lamps on a
+    /// wall at x = 6 facing +x: every emitter a floor patch's own cut can draw, the shared cut
+    /// of its neighbours can draw too, the probabilities still add up to one, and the wall's
+    /// lamps, which the group spanning x = 6 can see, are dropped for a patch wholly behind
+    /// their plane.
+    #[test]
+    fn a_shared_cut_draws_every_emitter_a_patch_can_see() {
+        use super::super::tests::{ceiling, lamps};
+        let mut quads = ceiling(12);
+        for j in 0..12 {
+            let y = j as f32;
+            // Facing +x.
+            quads.push([
+                Vec3::new(6.0, y, 1.0),
+                Vec3::new(6.0, y + 0.2, 1.0),
+                Vec3::new(6.0, y + 0.2, 1.2),
+                Vec3::new(6.0, y, 1.2),
+            ]);
+        }
+        let mesh = lamps(&quads);
+        let e = vec![Rgb::ONE; mesh.patches.len()];
+        let em = Emitters::new(&mesh, &e);
+        assert!(
+            em.patches.len() > super::super::CLUSTERS,
+            "a tree, not one node per emitter"
+        );
+        // Four floor patches, 0.2 m across, on both sides of the wall's plane.
+        let floor = |x: f32, y: f32| Receiver {
+            centre: Vec3::new(x, y, 0.0),
+            normal: Vec3::Z,
+            radius: 0.15,
+        };
+        let group = [
+            floor(5.5, 3.0),
+            floor(5.8, 3.0),
+            floor(6.2, 3.0),
+            floor(6.5, 3.1),
+        ];
+        let parts: Vec<(Receiver, f32)> = group.iter().map(|&r| (r, 0.04)).collect();
+        let cover = Receiver::covering(&parts);
+        assert!(group
+            .iter()
+            .all(|r| cover.centre.distance(r.centre) + r.radius <= cover.radius));
+        let shared = em.cut_nodes(&cover);
+        let w = |k: usize| scalar(e[em.patches[k]]) * mesh.patches[em.patches[k]].area;
+        let on_wall = |k: usize| mesh.patches[em.patches[k]].normal.x > 0.5;
+        for r in &group {
+            let own = em.draw_for(r).expect("lit from above");
+            let among = em.draw_among(&shared, r).expect("lit from above");
+            let (mut sum, mut wall) = (0.0, 0.0);
+            for k in 0..em.patches.len() {
+                let (m_own, m_among) = (em.mass(&own, k, w(k)), em.mass(&among, k, w(k)));
+                assert!(m_own == 0.0 || m_among > 0.0, "emitter {k} lost");
+                sum += m_among;
+                if on_wall(k) {
+                    wall += m_among;
+                }
+            }
+            assert!((sum - 1.0).abs() < 1e-9, "{sum}");
+            assert_eq!(wall > 0.0, r.centre.x + r.radius > 6.0, "{r:?}: {wall}");
+        }
+    }
 
     /// A node whose samples were all dark is drawn at about KEEP of its share; one whose
     /// samples were all seen takes the rest; the CDF still ends at exactly 1.
