@@ -452,6 +452,19 @@ impl SwitchPolicy {
         }
     }
 
+    /// Whether `rays` rays cost less by the counted model than the least a hemi-cube shot of
+    /// `cells` cells can cost (no face clipped, no cell tested).
+    fn rays_beat_any_cube(&self, rays: u64, cells: usize) -> bool {
+        let (_, least, by_rays) = counted_costs(
+            &self.model,
+            &WorkTally::default(),
+            self.patches,
+            cells,
+            rays,
+        );
+        by_rays < least
+    }
+
     /// Before hemi-cube shot number `shot` with a cube of `cells` cells: `Some` (the costs it
     /// compared) when this shot and all after it are to be cast by `rays` rays instead.
     /// `probe` measures the seconds per ray (`--switch-by measured` only; called once).
@@ -464,7 +477,12 @@ impl SwitchPolicy {
     ) -> Option<SwitchInfo> {
         let forced = self.switch_at.is_some_and(|k| shot >= k);
         let ready = match self.by {
-            SwitchBy::Counted => self.tally.shots >= 1,
+            // Before any hemi-cube shot the counted rule knows the work every shot does
+            // (transforming the patches, clearing the cells), not yet the clipping and depth
+            // tests: a lower bound of a hemi-cube shot's cost. Rays cheaper than that are
+            // cheaper than any hemi-cube shot (a million-patch model: 20 ms to transform its
+            // patches against 3 ms for a lamp's rays), and the hybrid casts rays from the first.
+            SwitchBy::Counted => self.tally.shots >= 1 || self.rays_beat_any_cube(rays, cells),
             SwitchBy::Measured => self.cube_cost.samples() >= 2,
         };
         if !forced && (self.switch_at.is_some() || !ready) {
@@ -510,6 +528,28 @@ mod tests {
             cells,
             tested,
         }
+    }
+
+    /// Before any hemi-cube shot, the counted rule switches only when rays beat the least a
+    /// hemi-cube shot can cost: at once on a million patches (a lamp's 10,368 rays against
+    /// transforming every patch), never on a small scene, which learns its shots' work first.
+    #[test]
+    fn rays_from_the_first_shot_only_when_cheaper_than_any_cube() {
+        let cfg = SolveSettings {
+            switch_by: SwitchBy::Counted,
+            ..SolveSettings::default()
+        };
+        let no_probe = || panic!("the counted rule never times rays");
+        let mut big = SwitchPolicy::new(&cfg, KEPT, 1_000_000);
+        let info = big
+            .consider(0, 10_368, 12_296, no_probe)
+            .expect("rays at once");
+        assert!(info.ray_shot_seconds < info.hemicube_shot_seconds);
+        assert_eq!(info.shot, 0);
+        let mut small = SwitchPolicy::new(&cfg, KEPT, 5_000);
+        assert!(small.consider(0, 50_000, 12_296, no_probe).is_none());
+        // A big scene's lamp whose rays would cost more than transforming it waits as before.
+        assert!(big.consider(0, 10_000_000, 12_296, no_probe).is_none());
     }
 
     #[test]
@@ -590,11 +630,15 @@ mod tests {
             counted_costs(&KEPT, &tally, 232, 5_000, 600)
         );
 
-        // The policy: nothing to go by before the first shot; then rays once they are cheaper.
+        // The policy: before the first shot, only the least a hemi-cube shot can cost to go by
+        // (transforming the patches, clearing the cells); then rays once they are cheaper.
         let cfg = SolveSettings::default();
         let mut p = SwitchPolicy::new(&cfg, KEPT, 232);
         let no_probe = || panic!("counted never measures");
-        assert!(p.consider(0, 1, 5_000, no_probe).is_none());
+        let least = 231.0 * KEPT.patch + 5_000.0 * KEPT.cell;
+        let above_least = (2.0 * least / KEPT.seconds_per_ray(232)) as u64;
+        assert!(p.consider(0, above_least, 5_000, no_probe).is_none());
+        assert!(p.consider(0, 1, 5_000, no_probe).is_some());
         let hits = CubeHits {
             work: work(100, 5_000, 10_000),
             ..CubeHits::default()
