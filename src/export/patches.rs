@@ -82,7 +82,62 @@ fn write_rows(
         Some(_) => writeln!(w, "{HEADER},{DAYLIGHT_COLUMNS},{PATCH_COLUMN}")?,
         None => writeln!(w, "{HEADER},{DAYLIGHT_COLUMNS}")?,
     }
-    for (i, p) in mesh.patches.iter().enumerate() {
+    // Rows formatted in parallel, chunk by chunk, and written in order: the same bytes as one
+    // row after another (formatting the numbers is most of the time on a large model).
+    use rayon::prelude::*;
+    let table = Table {
+        mesh,
+        materials,
+        b,
+        sky_lux,
+        parent,
+    };
+    let n = mesh.patches.len();
+    // At most CHUNKS_HELD chunks are held at once, so the memory stays bounded on any model.
+    let chunks: Vec<usize> = (0..n).step_by(ROWS_PER_CHUNK).collect();
+    for held in chunks.chunks(CHUNKS_HELD) {
+        let formatted: Vec<io::Result<Vec<u8>>> = held
+            .par_iter()
+            .map(|&first| {
+                let mut out = Vec::new();
+                for i in first..(first + ROWS_PER_CHUNK).min(n) {
+                    table.row(&mut out, i)?;
+                }
+                Ok(out)
+            })
+            .collect();
+        for chunk in formatted {
+            w.write_all(&chunk?)?;
+        }
+    }
+    Ok(())
+}
+
+/// Rows of a table formatted together by one thread ([`write_rows`]) ...
+const ROWS_PER_CHUNK: usize = 16_384;
+/// ... and chunks formatted before they are written (about 50 MB of text).
+const CHUNKS_HELD: usize = 16;
+
+/// What the rows of the patch or element table are made of ([`write_rows`]).
+struct Table<'a> {
+    mesh: &'a Mesh,
+    materials: &'a [Material],
+    b: &'a [[f64; 3]],
+    sky_lux: Option<f64>,
+    parent: Option<&'a [u32]>,
+}
+
+impl Table<'_> {
+    /// Row `i`.
+    fn row(&self, w: &mut Vec<u8>, i: usize) -> io::Result<()> {
+        let Table {
+            mesh,
+            materials,
+            b,
+            sky_lux,
+            parent,
+        } = *self;
+        let p = &mesh.patches[i];
         let m = &materials[p.material as usize];
         let e = m.emission();
         let vals = [
@@ -119,11 +174,10 @@ fn write_rows(
         let opt = |v: Option<f64>| v.map(|v| v.to_string()).unwrap_or_default();
         write!(w, ",{},{}", opt(lx), opt(df))?;
         match parent {
-            Some(pa) => writeln!(w, ",{}", pa[i])?,
-            None => writeln!(w)?,
+            Some(pa) => writeln!(w, ",{}", pa[i]),
+            None => writeln!(w),
         }
     }
-    Ok(())
 }
 
 /// One row read back.
