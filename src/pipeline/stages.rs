@@ -240,6 +240,8 @@ pub fn lit_backs(
     let total: f64 = per_polygon.values().sum::<f64>() + 0.0;
     let mut out = LitBacks {
         back_fraction: total / rested,
+        shots: sol.stats.shots,
+        rays: sol.stats.rays,
         ..LitBacks::default()
     };
     if total >= LIT_BACKS_MIN * rested {

@@ -456,6 +456,9 @@ pub struct LitBacks {
     pub patches: usize,
     /// Wall seconds of the first shooting.
     pub seconds: f64,
+    /// The first shooting's shots and rays.
+    pub shots: u64,
+    pub rays: u64,
 }
 
 /// Sides no light can reach (`mesh::Hidden`; `summary.json`: `hidden`): the patches whose side
