@@ -570,7 +570,12 @@ fn an_end_to_end_sweep_times_every_stage() {
             "{r}"
         );
     }
-    assert_eq!(json["summaries"].as_array().unwrap().len(), 2);
+    let summaries = json["summaries"].as_array().unwrap();
+    assert_eq!(summaries.len(), 2);
+    for s in summaries {
+        // `radiosity solve`'s defaults, its error target included.
+        assert_eq!(s["error_target"]["target"].as_f64(), Some(0.05), "{s}");
+    }
     let csv = std::fs::read_to_string(out.join("end-to-end.csv")).unwrap();
     assert_eq!(csv.lines().count(), 3, "{csv}");
     assert!(!csv.contains("NaN"));

@@ -363,7 +363,12 @@ pub fn sweep(a: SweepArgs) -> Result<(), radiosity::Error> {
     let job = sweep::SweepJob {
         sizes: a.sizes.0.clone(),
         methods: a.methods.clone(),
-        cfg: a.solve_args.settings(),
+        // End to end runs `radiosity solve`'s pipeline, so its defaults too (the error target).
+        cfg: if a.end_to_end {
+            a.solve_args.solve_settings()
+        } else {
+            a.solve_args.settings()
+        },
         intersector: a.solve_args.intersector(),
         out: a.out.clone(),
         seed: a.building_seed,
