@@ -343,13 +343,17 @@ struct Passes<'a, I> {
 
 impl<'a, I: Intersector> Passes<'a, I> {
     /// The state after the first pass, `first`.
-    fn after_first(at: Inputs<'a, I>, first: Solution) -> Self {
+    fn after_first(at: Inputs<'a, I>, mut first: Solution) -> Self {
         let cfg = at.cfg;
         let r1 = samples(&first);
         let c1 = first.stats.energy_per_ray;
         let m = estimate_of(&first);
         let trace = first.stats.trace.clone();
+        // The result holds no copy of the pass's shooting books (the result never shows them):
+        // on a million patches they and their gathers are hundreds of MB.
+        let shooting = first.shooting.take();
         let out = first.clone();
+        first.shooting = shooting;
         let sols = vec![first];
         let gather = at
             .isect
@@ -367,8 +371,11 @@ impl<'a, I: Intersector> Passes<'a, I> {
         };
         let last = (r1, m.weighted_percent);
         let first_gather_rays = out.stats.final_gather.map_or(0.0, |g| g.rays as f64);
+        // What a gather round starts from, made only when the first pass left the target to
+        // reach.
+        let unmet = m.weighted_percent > at.target;
         let base = match (gather, sols[0].shooting.as_deref()) {
-            (Some(_), Some(shot)) if shot.gathers.is_some() => {
+            (Some(_), Some(shot)) if unmet && shot.gathers.is_some() => {
                 let (pre, _, parts) = combine(at.mesh, &at.area, &at.emission, &sols);
                 let gathers = shot.gathers.clone().expect("checked");
                 Some(Base {
