@@ -115,13 +115,11 @@ impl<I: Intersector> Kernel<'_, I> {
         for (&(u, v), &(s, t)) in here.iter().zip(&there) {
             let from = spot.origin(u, v);
             // Stratified choice of the emitter, then a point on it from the rest of `s`.
-            let (e, mass, s2) = self.emitters.pick(&split.draw, f64::from(s));
+            let (e, mass, s2, node) = self.emitters.pick_node(&split.draw, f64::from(s));
             let y = self.emitters.at[e].points.at(s2, t);
             let (val, j, cast) = self.light_sample(&from, (e, mass), y, (split.nl, split.nc));
-            if let Some(l) = learned.as_deref_mut() {
-                if let Some(node) = self.emitters.node_at(&split.draw, f64::from(s)) {
-                    l.record(node, scalar(val) > 0.0);
-                }
+            if let (Some(l), Some(node)) = (learned.as_deref_mut(), node) {
+                l.record(node, scalar(val) > 0.0);
             }
             g.rays += u64::from(cast);
             m.push(scalar(spot.rho * val));

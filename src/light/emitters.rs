@@ -299,6 +299,13 @@ impl Emitters {
     /// The emitter (index into `patches`) that `s` ∈ [0, 1) picks by `draw`, its probability
     /// of being picked, and what is left of `s` within its stretch (for a point on it).
     pub fn pick(&self, draw: &Draw, s: f64) -> (usize, f64, f32) {
+        let (e, mass, rest, _) = self.pick_node(draw, s);
+        (e, mass, rest)
+    }
+
+    /// [`Emitters::pick`], and the node of the cut it picked from (`None` for a draw by power),
+    /// for what the gathers of a surface learn (`Learned::record`).
+    pub fn pick_node(&self, draw: &Draw, s: f64) -> (usize, f64, f32, Option<u32>) {
         match &draw.local {
             None => {
                 let target = s * self.power;
@@ -309,7 +316,7 @@ impl Emitters {
                 let lo = if e == 0 { 0.0 } else { self.cdf[e - 1] };
                 let w = (self.cdf[e] - lo).max(f64::MIN_POSITIVE);
                 let rest = (((target - lo) / w) as f32).clamp(0.0, 1.0);
-                (e, w / self.power, rest)
+                (e, w / self.power, rest, None)
             }
             Some(cut) => {
                 let last = cut.cdf.len() - 1;
@@ -345,7 +352,12 @@ impl Emitters {
                     (self.within[k] - base - lo2).max(f64::MIN_POSITIVE)
                 };
                 let rest = (((target - lo2) / w) as f32).clamp(0.0, 1.0);
-                (self.order[k] as usize, q * w / span, rest)
+                (
+                    self.order[k] as usize,
+                    q * w / span,
+                    rest,
+                    Some(cut.nodes[c]),
+                )
             }
         }
     }
@@ -569,7 +581,7 @@ fn cluster(
 mod tests {
     use super::*;
 
-    fn three(power: [f64; 3]) -> Emitters {
+    pub(super) fn three(power: [f64; 3]) -> Emitters {
         let mut acc = 0.0;
         let cdf: Vec<f64> = power
             .iter()

@@ -27,7 +27,7 @@
 //! unbiased, for a fraction of the cost of a cut of its own (the tree's nodes are searched
 //! once for the group).
 
-use super::{contribution, Cut, Draw, Emitters, Receiver};
+use super::{contribution, Draw, Emitters, Receiver};
 use glam::Vec3;
 
 /// The share of a learned draw that stays the cut's own (see the module notes): a node found
@@ -155,17 +155,9 @@ impl Emitters {
         self.draw_of(kept, est)
     }
 
-    /// The node of the cut that `s` picks by `draw` (as [`Emitters::pick`] does); `None` for a
-    /// draw by power.
-    pub fn node_at(&self, draw: &Draw, s: f64) -> Option<u32> {
-        let cut = draw.local.as_ref()?;
-        let c = cut.cdf.partition_point(|&x| x <= s).min(cut.cdf.len() - 1);
-        Some(cut.nodes[c])
-    }
-
     /// `draw` weighed by what `learned` found (module notes); a draw by power, or a cut none
     /// of whose nodes has been tried, stays as it is.
-    pub fn learned(&self, draw: Draw, learned: &Learned) -> Draw {
+    pub fn learned(&self, mut draw: Draw, learned: &Learned) -> Draw {
         let Some(cut) = draw.local.as_ref() else {
             return draw;
         };
@@ -194,12 +186,11 @@ impl Emitters {
             })
             .collect();
         *cdf.last_mut().expect("a cut is never empty") = 1.0;
-        Draw {
-            local: Some(Cut {
-                nodes: cut.nodes.clone(),
-                cdf,
-            }),
+        // The same nodes, drawn by the new CDF.
+        if let Some(cut) = draw.local.as_mut() {
+            cut.cdf = cdf;
         }
+        draw
     }
 }
 
@@ -272,30 +263,34 @@ mod tests {
     }
 
     /// A node whose samples were all dark is drawn at about KEEP of its share; one whose
-    /// samples were all seen takes the rest; the CDF still ends at exactly 1.
+    /// samples were all seen takes the rest; the CDF still ends at exactly 1, and a pick
+    /// reports the node it drew from (what the next sample is recorded against).
     #[test]
     fn a_dark_node_keeps_only_its_defensive_share() {
+        // Three emitters: node 3 holds the first two, node 2 is the third.
+        let em = super::super::tests::three([1.0, 1.0, 1.0]);
         let draw = Draw {
-            local: Some(Cut {
-                nodes: vec![3, 7],
+            local: Some(super::super::Cut {
+                nodes: vec![3, 2],
                 cdf: vec![0.5, 1.0],
             }),
         };
         let mut l = Learned::default();
         for _ in 0..200 {
             l.record(3, false);
-            l.record(7, true);
+            l.record(2, true);
         }
         l.settle();
         assert!(l.counts.iter().all(|&(_, _, t)| t <= MEMORY));
-        // Emitters are not read by `learned` beyond the draw: an empty set will do.
-        let em = Emitters::new(&crate::mesh::Mesh::default(), &[]);
         let d = em.learned(draw, &l);
         let cdf = &d.local.as_ref().unwrap().cdf;
         let dark = cdf[0];
         assert!((dark - KEEP * 0.5).abs() < 0.01, "{dark}");
         assert_eq!(cdf[1], 1.0);
-        assert_eq!(em.node_at(&d, 0.05), Some(3));
-        assert_eq!(em.node_at(&d, 0.5), Some(7));
+        let (e, _, _, node) = em.pick_node(&d, 0.05);
+        assert_eq!((node, e < 2), (Some(3), true));
+        let (e, mass, _, node) = em.pick_node(&d, 0.5);
+        assert_eq!((e, node), (2, Some(2)));
+        assert!((mass - (1.0 - dark)).abs() < 1e-12, "{mass}");
     }
 }
