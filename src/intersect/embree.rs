@@ -7,14 +7,20 @@
 //! `RTCRayHit` laid out from the 4.2 headers, i.e. past its stack variable. `RayHitSlack`
 //! gives that write somewhere to land. Its `Device` cannot be used on its own either: the
 //! handle is crate-private (so no scene of ours can be made on it), the type is `!Send`, and
-//! `Device::try_new` hands `rtcNewDevice` a Rust `&str` that is not NUL-terminated. Patches are fanned into triangles; `prim_patch` maps Embree's primitive ids back.
+//! `Device::try_new` hands `rtcNewDevice` a Rust `&str` that is not NUL-terminated.
+//!
+//! A piece cut into a regular grid of patches goes in whole, as its quad's two triangles
+//! (`crate::mesh::grids`: the patch is found from the hit's coordinates); every other patch as
+//! its fan triangles; `prims` maps Embree's primitive ids back (docs/design.md §3, "Grids").
 //! The scene is built with `RTC_SCENE_FLAG_ROBUST` so rays do not slip through shared edges of a
 //! closed room (measured: without it, a few rays per million escape a closed box).
 #![allow(unsafe_code)]
 
 use super::{Hit, Intersector, Ray};
+use crate::mesh::grids::Cells;
 use crate::mesh::Mesh;
 use embree4_sys as sys;
+use glam::Vec3;
 use std::ffi::CString;
 
 /// Why Embree could not be used.
@@ -31,11 +37,16 @@ pub enum EmbreeError {
     TooLarge(usize),
 }
 
-/// A committed Embree scene over (a subset of) the mesh's patches.
+/// A committed Embree scene over (a subset of) the mesh's patches: the pieces cut into regular
+/// grids whole (`crate::mesh::grids`: two triangles each, the patch found from the hit's
+/// coordinates), every other patch as its fan triangles.
 pub struct EmbreeScene {
     device: sys::RTCDevice,
     scene: sys::RTCScene,
-    prim_patch: Vec<u32>,
+    /// Per triangle: its patch, or its grid's layout as its half of the grid's quad reads it.
+    prims: Vec<Cells>,
+    /// How many grids went in whole.
+    grids: usize,
 }
 
 // Embree documents committed scenes as safe to query from any number of threads at once, and
@@ -74,7 +85,8 @@ pub fn set_flush_denormals() {
 
 impl EmbreeScene {
     /// Builds a scene from the surface patches (never a back twin, docs/design.md §7) for
-    /// which `keep(patch index)` holds.
+    /// which `keep(patch index)` holds: a grid whose patches are all kept as its quad, the
+    /// others as triangles.
     pub fn build(mesh: &Mesh, keep: impl Fn(usize) -> bool) -> Result<EmbreeScene, EmbreeError> {
         set_flush_denormals();
         let config = CString::new("verbose=0").expect("no NUL");
@@ -87,56 +99,43 @@ impl EmbreeScene {
         let mut me = EmbreeScene {
             device,
             scene: std::ptr::null_mut(),
-            prim_patch: Vec::new(),
+            prims: Vec::new(),
+            grids: 0,
         };
         let mut index: Vec<u32> = Vec::new();
-        for (tri, patch) in mesh.surface_triangles() {
-            if keep(patch as usize) {
-                index.extend_from_slice(&tri);
-                me.prim_patch.push(patch);
+        let mut in_grid = vec![false; mesh.patches.len()];
+        for g in &mesh.grids {
+            let r = g.patches();
+            if r.end <= mesh.patches.len() && r.clone().all(|p| mesh.is_surface(p) && keep(p)) {
+                in_grid[r].fill(true);
+                // Two triangles, (0, 1, 3) and (2, 3, 1), as Embree splits a quad; a
+                // triangle's grid only the first.
+                let c = g.corners;
+                index.extend_from_slice(&[c[0], c[1], c[3]]);
+                me.prims.push(g.cells);
+                if !g.is_triangle() {
+                    index.extend_from_slice(&[c[2], c[3], c[1]]);
+                    me.prims.push(g.second_half());
+                }
+                me.grids += 1;
             }
         }
-        if me.prim_patch.len() >= u32::MAX as usize {
-            return Err(EmbreeError::TooLarge(me.prim_patch.len()));
+        for (tri, patch) in mesh.surface_triangles() {
+            if keep(patch as usize) && !in_grid[patch as usize] {
+                index.extend_from_slice(&tri);
+                me.prims.push(Cells::single(patch));
+            }
+        }
+        if me.prims.len() >= u32::MAX as usize {
+            return Err(EmbreeError::TooLarge(me.prims.len()));
         }
         unsafe {
             me.scene = sys::rtcNewScene(device);
             check(device, "rtcNewScene")?;
             sys::rtcSetSceneFlags(me.scene, sys::RTCSceneFlags::ROBUST);
             sys::rtcSetSceneBuildQuality(me.scene, sys::RTCBuildQuality::MEDIUM);
-            if !me.prim_patch.is_empty() {
-                let geom = sys::rtcNewGeometry(device, sys::RTCGeometryType::TRIANGLE);
-                check(device, "rtcNewGeometry")?;
-                let nv = mesh.vertices.len();
-                // Embree reads vertex buffers 16 bytes at a time: one spare float at the end.
-                let vb = sys::rtcSetNewGeometryBuffer(
-                    geom,
-                    sys::RTCBufferType::VERTEX,
-                    0,
-                    sys::RTCFormat::FLOAT3,
-                    12,
-                    nv + 1,
-                ) as *mut f32;
-                check(device, "vertex buffer")?;
-                let vbs = std::slice::from_raw_parts_mut(vb, 3 * (nv + 1));
-                for (k, v) in mesh.vertices.iter().enumerate() {
-                    vbs[3 * k..3 * k + 3].copy_from_slice(&v.to_array());
-                }
-                vbs[3 * nv..].fill(0.0);
-                let ib = sys::rtcSetNewGeometryBuffer(
-                    geom,
-                    sys::RTCBufferType::INDEX,
-                    0,
-                    sys::RTCFormat::UINT3,
-                    12,
-                    me.prim_patch.len(),
-                ) as *mut u32;
-                check(device, "index buffer")?;
-                std::slice::from_raw_parts_mut(ib, index.len()).copy_from_slice(&index);
-                sys::rtcCommitGeometry(geom);
-                sys::rtcAttachGeometry(me.scene, geom);
-                sys::rtcReleaseGeometry(geom);
-                check(device, "geometry")?;
+            if !me.prims.is_empty() {
+                me.attach_triangles(&mesh.vertices, &index)?;
             }
             sys::rtcCommitScene(me.scene);
             check(device, "rtcCommitScene")?;
@@ -144,9 +143,54 @@ impl EmbreeScene {
         Ok(me)
     }
 
-    /// Number of triangles in the scene.
+    /// Attaches the triangles `index` (vertex indices, three a triangle) over `vertices`.
+    ///
+    /// # Safety
+    /// `self.scene` is a live, uncommitted scene of `self.device`.
+    unsafe fn attach_triangles(&self, vertices: &[Vec3], index: &[u32]) -> Result<(), EmbreeError> {
+        let device = self.device;
+        let geom = sys::rtcNewGeometry(device, sys::RTCGeometryType::TRIANGLE);
+        check(device, "rtcNewGeometry")?;
+        let nv = vertices.len();
+        // Embree reads vertex buffers 16 bytes at a time: one spare float at the end.
+        let vb = sys::rtcSetNewGeometryBuffer(
+            geom,
+            sys::RTCBufferType::VERTEX,
+            0,
+            sys::RTCFormat::FLOAT3,
+            12,
+            nv + 1,
+        ) as *mut f32;
+        check(device, "vertex buffer")?;
+        let vbs = std::slice::from_raw_parts_mut(vb, 3 * (nv + 1));
+        for (k, v) in vertices.iter().enumerate() {
+            vbs[3 * k..3 * k + 3].copy_from_slice(&v.to_array());
+        }
+        vbs[3 * nv..].fill(0.0);
+        let ib = sys::rtcSetNewGeometryBuffer(
+            geom,
+            sys::RTCBufferType::INDEX,
+            0,
+            sys::RTCFormat::UINT3,
+            12,
+            index.len() / 3,
+        ) as *mut u32;
+        check(device, "index buffer")?;
+        std::slice::from_raw_parts_mut(ib, index.len()).copy_from_slice(index);
+        sys::rtcCommitGeometry(geom);
+        sys::rtcAttachGeometry(self.scene, geom);
+        sys::rtcReleaseGeometry(geom);
+        check(device, "geometry")
+    }
+
+    /// Number of triangles in the scene: the patches' and the grids'.
     pub fn triangle_count(&self) -> usize {
-        self.prim_patch.len()
+        self.prims.len()
+    }
+
+    /// How many grids the scene takes whole.
+    pub fn grid_count(&self) -> usize {
+        self.grids
     }
 }
 
@@ -193,8 +237,9 @@ impl Intersector for EmbreeScene {
         // the tests below), so a back hit has Ng·dir > 0. Reading the side from Ng saves a
         // cache miss on the patch array per ray.
         let ng_dot_dir = h.Ng_x * ray.dir.x + h.Ng_y * ray.dir.y + h.Ng_z * ray.dir.z;
+        let patch = self.prims[h.primID as usize].patch_at(h.u, h.v);
         Some(Hit {
-            patch: self.prim_patch[h.primID as usize],
+            patch,
             t: rh.rh.ray.tfar,
             back: ng_dot_dir > 0.0,
         })

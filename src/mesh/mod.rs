@@ -21,8 +21,10 @@
 //! | `contact.rs`   | faces lying on faces that face them            |
 //! | `near_lights.rs` | patches cut finer where a light is close     |
 //! | `spatial.rs`   | patches in space order (facing, Morton curve)  |
+//! | `grids.rs`     | pieces cut into regular grids of patches       |
 
 mod contact;
+pub mod grids;
 mod hidden;
 mod near_lights;
 pub use contact::Contacts;
@@ -107,6 +109,9 @@ pub struct Mesh {
     /// The scene's luminaires (`Scene::luminaires`): lights with no patch, which shoot first
     /// and are gathered by shadow rays (`solve::luminaire_shots`, `light::luminaires`).
     pub luminaires: Vec<crate::luminaire::Luminaire>,
+    /// The pieces cut into regular grids of patches, which Embree takes whole ([`grids`]);
+    /// empty for a mesh not made by [`build`] (every patch is then its own primitive).
+    pub grids: Vec<grids::Grid>,
 }
 
 impl Mesh {

@@ -4,6 +4,7 @@
 //! area centroid, normal and class.
 
 use super::classify::classify;
+use super::grids::Grid;
 use super::near_lights::{NearLights, NEAR_LIGHT_CUTS};
 use super::{newell, Mesh, Patch, Side};
 use glam::Vec3;
@@ -20,6 +21,8 @@ pub(super) struct Builder {
     pub(super) near: Option<NearLights>,
     /// Whether the polygon being added is refined near lights (not a light itself).
     pub(super) refine_near: bool,
+    /// Whether a patch of the grid being cut was cut finer or dropped (no [`Grid`] then).
+    irregular: bool,
 }
 
 impl Builder {
@@ -34,6 +37,7 @@ impl Builder {
             weld: HashMap::new(),
             near: None,
             refine_near: false,
+            irregular: false,
         }
     }
 
@@ -73,12 +77,22 @@ impl Builder {
                     .map(|p| self.vertex(p, n, material))
                     .collect();
                 let g = |i: usize, j: usize| grid[j * (m + 1) + i];
+                let start = self.begin_grid();
                 for j in 0..k {
                     for i in 0..m {
                         let ids = [g(i, j), g(i + 1, j), g(i + 1, j + 1), g(i, j + 1)];
                         self.push_patch(&ids, n, material, polygon);
                     }
                 }
+                let ids = [g(0, 0), g(m, 0), g(m, k), g(0, k)];
+                let grid = Grid::quad(
+                    ids,
+                    ids.map(|v| self.position(v)),
+                    m as u32,
+                    k as u32,
+                    start,
+                );
+                self.end_grid(start, grid);
             }
             count => {
                 let longest = (0..count)
@@ -138,6 +152,7 @@ impl Builder {
             }
         }
         let g = |i: usize, j: usize| ids[row_start[j] + i];
+        let start = self.begin_grid();
         for j in 0..k {
             for i in 0..(k - j) {
                 self.push_patch(&[g(i, j), g(i + 1, j), g(i, j + 1)], n, material, polygon);
@@ -150,6 +165,27 @@ impl Builder {
                     );
                 }
             }
+        }
+        let ids = [g(0, 0), g(k, 0), g(0, k)];
+        self.end_grid(start, Grid::triangle(ids, k as u32, start));
+    }
+
+    /// Where welded vertex `v` is (a grid's corners are its patches' own, welded).
+    fn position(&self, v: u32) -> Vec3 {
+        self.mesh.vertices[v as usize]
+    }
+
+    /// The first patch of a grid about to be cut.
+    fn begin_grid(&mut self) -> u32 {
+        self.irregular = false;
+        self.mesh.patches.len() as u32
+    }
+
+    /// Keeps `grid` (its patches from `start` on) if every patch of it was made as cut.
+    fn end_grid(&mut self, start: u32, grid: Grid) {
+        let made = self.mesh.patches.len() as u32 - start;
+        if !self.irregular && made == grid.count() {
+            self.mesh.grids.push(grid);
         }
     }
 
@@ -171,6 +207,7 @@ impl Builder {
         if !cut {
             return self.push_final(ids, n, material, polygon);
         }
+        self.irregular = true;
         let count = pts.len();
         let mid: Vec<u32> = (0..count)
             .map(|k| self.vertex(along(pts[k], pts[(k + 1) % count], 0.5), n, material))
@@ -207,6 +244,7 @@ impl Builder {
         let nn = newell(&pts);
         let area = nn.length() as f64 * 0.5;
         if area <= 0.0 {
+            self.irregular = true;
             return;
         }
         // The centroid of the polygon's area (not of its vertices), from its fan triangles.

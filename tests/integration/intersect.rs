@@ -617,7 +617,9 @@ fn hybrid_builds_only_what_the_scene_needs() {
     assert!(skew.patches.iter().all(|p| p.class == PatchClass::Skew));
     let h = Hybrid::build(&skew).unwrap();
     assert!(h.merge().is_none(), "no plane lists without axial patches");
-    assert_eq!(h.embree().unwrap().triangle_count(), skew.patches.len());
+    // Each face is a triangle cut into a grid of patches, which Embree takes whole.
+    let e = h.embree().unwrap();
+    assert_eq!((e.grid_count(), e.triangle_count()), (4, 4));
     let hit = h
         .intersect(&ray(Vec3::ZERO, Vec3::X))
         .expect("inside the tetrahedron");
@@ -935,4 +937,68 @@ fn a_ray_just_beyond_two_patches_ending_on_one_free_edge_misses_them() {
         assert_eq!(want, Some(2), "the oracle reaches the floor below");
         assert_eq!(merge.intersect(&r).map(|h| h.patch), want, "dx {dx}");
     }
+}
+
+#[test]
+fn embree_finds_the_patch_of_a_grid_it_takes_whole_like_brute_force() {
+    // Pieces Embree takes whole (a tilted quad far from a parallelogram, a triangle, a large
+    // hexagon fanned into triangles) and, near a lamp, patches cut finer that it does not.
+    let mut s = grey_scene();
+    s.materials.push(material("lamp", 0.0, 10.0));
+    let (x, y) = (vec3(0.8, 0.0, 0.6), vec3(0.0, 0.6, -0.8));
+    let flat = [(0.0, 0.0), (4.0, 0.5), (5.0, 3.5), (0.5, 2.0)];
+    let twisted: Vec<Vec3> = flat.iter().map(|&(a, b)| x * a + y * b).collect();
+    polygon(&mut s, &twisted, 0);
+    polygon(
+        &mut s,
+        &[vec3(-3., -2., -4.), vec3(3., -2.5, -4.), vec3(0., 3., -4.2)],
+        0,
+    );
+    let hexagon: Vec<Vec3> = (0..6)
+        .map(|k| {
+            let a = k as f32 * std::f32::consts::TAU / 6.0;
+            vec3(2.0 * a.cos(), -3.0, 2.0 * a.sin() - 1.0)
+        })
+        .collect();
+    polygon_facing(&mut s, &hexagon, Vec3::Y, 0);
+    // A floor under a small lamp a hand's width above it: cut finer under the lamp.
+    polygon_facing(
+        &mut s,
+        &[
+            vec3(-4., 4., -6.),
+            vec3(4., 4., -6.),
+            vec3(4., 4., 2.),
+            vec3(-4., 4., 2.),
+        ],
+        -Vec3::Y,
+        0,
+    );
+    polygon_facing(
+        &mut s,
+        &[
+            vec3(-0.2, 3.9, -2.2),
+            vec3(0.2, 3.9, -2.2),
+            vec3(0.2, 3.9, -1.8),
+            vec3(-0.2, 3.9, -1.8),
+        ],
+        Vec3::Y,
+        1,
+    );
+    let m = mesh_at(&s, Some(0.5));
+    let in_grids: usize = m.grids.iter().map(|g| g.count() as usize).sum();
+    assert!(m.grids.len() >= 8 && m.grids.iter().any(|g| g.is_triangle()));
+    assert!(
+        in_grids < m.patches.len(),
+        "some patches cut finer near the lamp"
+    );
+    let e = EmbreeScene::build(&m, |_| true).unwrap();
+    assert_eq!(e.grid_count(), m.grids.len());
+    let brute = BruteForce::new(&m);
+    let rays = RayGen::new(&m).rays(100_000, 3);
+    let (agreed, diffs) = compare(&m, &e, &brute, &rays);
+    assert_no_real("embree with grids vs brute", &diffs);
+    assert!(
+        agreed as f64 >= 0.999 * rays.len() as f64,
+        "agreed {agreed}"
+    );
 }
