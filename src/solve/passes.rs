@@ -64,6 +64,10 @@ pub struct ErrorTarget {
     /// Further gather rounds pooled with the last pass's gather ([`MAX_REGATHERS`] at most).
     #[serde(default)]
     pub regathers: u32,
+    /// The estimate the last gather round's model predicted (against `estimate`, what it
+    /// reached), if a round was taken.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub round_predicted: Option<f64>,
     /// Stopped by the default target's bound ([`super::settings::DEFAULT_ERROR_MAX_FACTOR`]).
     pub gave_up: bool,
 }
@@ -71,6 +75,12 @@ pub struct ErrorTarget {
 /// A pass aims at this fraction of the error target (module notes): the estimate is itself
 /// noisy and its rate of fall is known only roughly, and undershooting costs a further pass.
 pub const AIM: f64 = 0.85;
+
+/// A gather round aims at this fraction of the error target: its model predicts it closely
+/// (reached 1.03–1.07 × predicted on the generated buildings, 100 k to 10 M patches), and a
+/// round that misses is followed by a small one, not a whole pass. At [`AIM`] a round after a
+/// near miss cost more than the first gather (10 M: 5.08 % → 4.55 % for 1.84 G rays).
+pub const ROUND_AIM: f64 = 0.9;
 
 /// The rate p of e ∝ R^−p from two (samples, estimate) points, kept within [¼, ½]: ½ is pure
 /// sampling noise, and a rate below ¼ (an estimate barely moving, say from a noisy point) would
@@ -339,6 +349,7 @@ struct Passes<'a, I> {
     /// The last final gather, for further rounds.
     base: Option<Base>,
     regathers: u32,
+    round_predicted: Option<f64>,
 }
 
 impl<'a, I: Intersector> Passes<'a, I> {
@@ -403,6 +414,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
             p: 0.5,
             base,
             regathers: 0,
+            round_predicted: None,
         }
     }
 
@@ -428,7 +440,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
             let plan = match (self.gather, self.base.as_ref()) {
                 (Some(_), Some(b)) if self.regathers < MAX_REGATHERS => b.gathers.plan(
                     self.at.mesh.patches.len(),
-                    AIM * target,
+                    ROUND_AIM * target,
                     super::settings::MAX_GATHER_RAYS,
                 ),
                 _ => None,
@@ -481,6 +493,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
         let more = Some((b.gathers, plan.extra.as_slice()));
         let (sol, em, nb) = self.gathered(isect, b.pre, b.parts, 1.0, more);
         self.regathers += 1;
+        self.round_predicted = Some(plan.predicted);
         (self.out, self.m) = (sol, em);
         self.base = Some(nb);
         self.record(on_trace);
@@ -636,6 +649,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
             reached: m.weighted_percent <= target,
             passes: self.sols.len() as u32,
             regathers: self.regathers,
+            round_predicted: self.round_predicted,
             gave_up: self.capped,
         });
         out
