@@ -365,7 +365,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
         let shooting = first.shooting.take();
         let out = first.clone();
         first.shooting = shooting;
-        let sols = vec![first];
+        let mut sols = vec![first];
         let gather = at
             .isect
             .filter(|_| cfg.final_gather && cfg.method.casts_rays());
@@ -385,10 +385,11 @@ impl<'a, I: Intersector> Passes<'a, I> {
         // What a gather round starts from, made only when the first pass left the target to
         // reach.
         let unmet = m.weighted_percent > at.target;
-        let base = match (gather, sols[0].shooting.as_deref()) {
-            (Some(_), Some(shot)) if unmet && shot.gathers.is_some() => {
+        // The pass's gathers move to the base: nothing reads them from the pass again.
+        let first_gathers = sols[0].shooting.as_mut().and_then(|s| s.gathers.take());
+        let base = match (gather, first_gathers) {
+            (Some(_), Some(gathers)) if unmet => {
                 let (pre, _, parts) = combine(at.mesh, &at.area, &at.emission, &sols);
-                let gathers = shot.gathers.clone().expect("checked");
                 Some(Base {
                     pre,
                     parts,
