@@ -85,8 +85,8 @@ pub fn set_flush_denormals() {
 
 impl EmbreeScene {
     /// Builds a scene from the surface patches (never a back twin, docs/design.md §7) for
-    /// which `keep(patch index)` holds: a grid whose patches are all kept as its quad, the
-    /// others as triangles.
+    /// which `keep(patch index)` holds: a grid whose patches are all kept as its quad (two
+    /// triangles), the others as their fan triangles.
     pub fn build(mesh: &Mesh, keep: impl Fn(usize) -> bool) -> Result<EmbreeScene, EmbreeError> {
         set_flush_denormals();
         let config = CString::new("verbose=0").expect("no NUL");

@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 /// A piece cut into a regular grid of patches `first..first + count()`, numbered as
-/// [`super::subdivide`] pushes them.
+/// the mesh builder (`subdivide.rs`) pushes them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
     /// The piece's corners (welded vertices of [`super::Mesh::vertices`]), counter-clockwise
