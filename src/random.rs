@@ -39,6 +39,8 @@ pub enum Stream {
     Hidden,
     /// The luminaires' shots (`u64::MAX − 7`, `solve::luminaire_shots`).
     Luminaires,
+    /// The emitters' sight rays before a gather (`u64::MAX − 8`, `light::emitters`).
+    Sight,
 }
 
 /// Regather round k draws under `Stream::Gather`'s number less k times this.
@@ -58,6 +60,7 @@ impl Stream {
             Stream::Elements => u64::MAX - 5,
             Stream::Hidden => u64::MAX - 6,
             Stream::Luminaires => u64::MAX - 7,
+            Stream::Sight => u64::MAX - 8,
         }
     }
 }
@@ -88,5 +91,7 @@ mod tests {
         assert_eq!(Stream::Picture.id(), u64::MAX - 4);
         assert_eq!(Stream::Elements.id(), u64::MAX - 5);
         assert_eq!(Stream::Hidden.id(), u64::MAX - 6);
+        assert_eq!(Stream::Luminaires.id(), u64::MAX - 7);
+        assert_eq!(Stream::Sight.id(), u64::MAX - 8);
     }
 }

@@ -34,6 +34,7 @@
 //! power.
 
 mod learn;
+mod sight;
 
 use super::{scalar, Rgb};
 use crate::mesh::spatial::{facing_class, space_order};
@@ -94,6 +95,8 @@ pub(crate) struct Emitters {
     position: Vec<u32>,
     /// Per place in `order`: the cumulative power up to and including it.
     within: Vec<f64>,
+    /// Which sides the emitters' sight rays reached ([`Kernel::learn_sight`](crate::light::Kernel)), once cast.
+    sight: Option<sight::Sight>,
 }
 
 /// How one receiver draws its light samples: by power, or by the estimated contributions of
@@ -187,6 +190,7 @@ impl Emitters {
             order,
             position,
             within,
+            sight: None,
         }
     }
 
@@ -205,7 +209,7 @@ impl Emitters {
     /// the nodes that can light `r` at all. `None` when none can: no light sample could reach
     /// `r`.
     pub fn draw_for(&self, r: &Receiver) -> Option<Draw> {
-        let (nodes, est) = self.cut_for(r);
+        let (nodes, est) = self.cut_for(r, None);
         self.draw_of(nodes, est)
     }
 
@@ -242,11 +246,12 @@ impl Emitters {
     /// halves can give no more). So the emitters near the receiver are drawn one by one, by
     /// their own estimates, and those far away by the power of the whole node holding them.
     /// Returns the nodes in tree order and their estimates, all positive.
-    fn cut_for(&self, r: &Receiver) -> (Vec<u32>, Vec<f64>) {
+    fn cut_for(&self, r: &Receiver, reached: Option<&[u32]>) -> (Vec<u32>, Vec<f64>) {
         use std::collections::BinaryHeap;
-        /// A node of the cut, ordered by its estimate, then by index (a deterministic split).
+        /// A node of the cut, ordered by its priority, then by index (a deterministic split);
+        /// and its estimate.
         #[derive(PartialEq)]
-        struct Open(f64, u32);
+        struct Open(f64, u32, f64);
         impl Eq for Open {}
         impl PartialOrd for Open {
             fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
@@ -268,7 +273,7 @@ impl Emitters {
             let w = contribution(node, r);
             if w > 0.0 {
                 match node.children {
-                    Some(_) => open.push(Open(w, n)),
+                    Some(_) => open.push(Open(w * sight::split_priority(node, reached), n, w)),
                     None => done.push((node.start as u32, n, w)),
                 }
             }
@@ -279,7 +284,7 @@ impl Emitters {
             held += usize::from(file(n, &mut open, &mut done));
         }
         while held < CLUSTERS {
-            let Some(Open(_, n)) = open.pop() else {
+            let Some(Open(_, n, _)) = open.pop() else {
                 break;
             };
             let [a, b] = self.nodes[n as usize]
@@ -290,7 +295,7 @@ impl Emitters {
             held += usize::from(file(b, &mut open, &mut done));
         }
         // The cut is full: the nodes still open join it as they are (their order is the sort's).
-        done.extend(open.into_iter().map(|Open(w, n)| (start(n), n, w)));
+        done.extend(open.into_iter().map(|Open(_, n, w)| (start(n), n, w)));
         // Nodes of a cut cover disjoint stretches of the order: their first places differ.
         done.sort_unstable_by_key(|&(s, _, _)| s);
         done.into_iter().map(|(_, n, w)| (n, w)).unzip()
@@ -617,6 +622,7 @@ mod tests {
             roots: vec![4],
             order: vec![0, 1, 2],
             position: vec![0, 1, 2],
+            sight: None,
         }
     }
 

@@ -158,7 +158,12 @@ impl<I: Intersector> Kernel<'_, I> {
                 let l = learned.as_deref();
                 let draw = match l.and_then(Learned::shared_cut) {
                     Some(nodes) => self.emitters.draw_among(nodes, &r),
-                    None => self.emitters.draw_for(&r),
+                    None if spot.patch == super::NO_PATCH => self.emitters.draw_for(&r),
+                    None => self.emitters.draw_shaped(&r, spot.patch),
+                };
+                let draw = match spot.patch {
+                    super::NO_PATCH => draw,
+                    i => draw.map(|d| self.emitters.sighted(d, i)),
                 };
                 draw.map(|d| match l {
                     Some(l) => self.emitters.learned(d, l),
@@ -200,7 +205,7 @@ impl<I> Kernel<'_, I> {
         let parts: Vec<(Receiver, f32)> = (patches.iter())
             .map(|&i| (self.patch_receiver(i), self.mesh.patches[i].area as f32))
             .collect();
-        let nodes = self.emitters.cut_nodes(&Receiver::covering(&parts));
+        let nodes = (self.emitters).cut_nodes_shaped(&Receiver::covering(&parts), patches[0]);
         learned.share_cut(Some(nodes));
     }
 

@@ -121,7 +121,7 @@ impl<I: Intersector> Kernel<'_, I> {
     }
 
     /// The side a ray's hit gives its light to, and how far it is.
-    fn receiver_of(&self, hit: Option<Hit>) -> Option<(usize, f32)> {
+    pub(super) fn receiver_of(&self, hit: Option<Hit>) -> Option<(usize, f32)> {
         hit.and_then(|h| Some((self.mesh.receiver(h.patch, h.back)? as usize, h.t)))
     }
 

@@ -220,6 +220,8 @@ pub struct Gathers {
     /// Rounds so far, and their wall-clock seconds.
     rounds: u64,
     seconds: f64,
+    /// The emitters' sight rays cast before the rounds (`crate::light::emitters`).
+    sight_rays: u64,
 }
 
 /// One gathered patch's error model: the shooting's variance and the gather's (of ρ·H's mean,
@@ -266,7 +268,7 @@ pub struct RegatherPlan {
 impl Gathers {
     /// Rays cast by every round so far.
     pub fn rays(&self) -> u64 {
-        self.got.iter().map(|g| g.rays).sum()
+        self.got.iter().map(|g| g.rays).sum::<u64>() + self.sight_rays
     }
 
     /// Where to add gather rays so that the estimate (the mean relative error over the
@@ -387,11 +389,14 @@ pub fn apply<I: Intersector>(
             channels: &sol.channels,
             group: inp.group.filter(|_| !sol.channels.is_empty()),
         };
-        let kernel = Kernel::new(inp.mesh, inp.materials, inp.isect, solved, inp.sky);
-        match more {
+        let mut kernel = Kernel::new(inp.mesh, inp.materials, inp.isect, solved, inp.sky);
+        let sight_rays = kernel.learn_sight(inp.seed);
+        let mut gathers = match more {
             Some(more) => regather(&kernel, inp.seed, more),
             None => first_round(&kernel, inp.seed, inp.rays.max(4), sol),
-        }
+        };
+        gathers.sight_rays += sight_rays;
+        gathers
     };
     let c = combine(inp, sol, (&e, &rho), &area, &gathers);
     let seconds = t0.elapsed().as_secs_f64();
@@ -695,6 +700,7 @@ mod tests {
             count: 2,
             rounds: 0,
             seconds: 0.0,
+            sight_rays: 0,
         };
         let now = (g.model[0].relative(1.0) + g.model[1].relative(1.0)) / 2.0;
         assert!((now - 0.055).abs() < 1e-9, "{now}");

@@ -134,12 +134,6 @@ impl Receiver {
 }
 
 impl Emitters {
-    /// The nodes of `r`'s cut ([`Emitters::draw_for`]), to be shared by the patches `r`
-    /// covers ([`Learned::share_cut`]).
-    pub fn cut_nodes(&self, r: &Receiver) -> Vec<u32> {
-        self.cut_for(r).0
-    }
-
     /// The draw of receiver `r` among the nodes of a shared cut, each weighed for `r` as its
     /// own cut would weigh it; the nodes that can give `r` nothing dropped. `None` when none
     /// can.
@@ -242,7 +236,7 @@ mod tests {
         assert!(group
             .iter()
             .all(|r| cover.centre.distance(r.centre) + r.radius <= cover.radius));
-        let shared = em.cut_nodes(&cover);
+        let shared = em.cut_for(&cover, None).0;
         let w = |k: usize| scalar(e[em.patches[k]]) * mesh.patches[em.patches[k]].area;
         let on_wall = |k: usize| mesh.patches[em.patches[k]].normal.x > 0.5;
         for r in &group {
