@@ -1,4 +1,4 @@
-//! An indexed binary heap of patches by a key (unshot flux, unshot radiosity): the books'
+//! An indexed 4-ary heap of patches by a key (unshot flux, unshot radiosity): the books'
 //! queues ([`super::books`]). A patch is in it at most once and moves when its key changes, so
 //! picking a shooter costs O(log patches), never a scan, and no stale entry is popped (an
 //! earlier design pushed a new entry per change: on a million patches a sixth of the
@@ -36,6 +36,11 @@ pub(super) struct KeyHeap {
 
 /// [`KeyHeap::pos`] of a patch not in the heap.
 const ABSENT: u32 = u32::MAX;
+
+/// Children per node: a 4-ary heap is half as deep as a binary one, and a node's four
+/// children (16 bytes each) share a cache line. The top is the largest entry whatever the
+/// arity (keys and ties make a total order), so the solver's shots are the same.
+const ARITY: usize = 4;
 
 impl KeyHeap {
     pub(super) fn with_patches(n: usize) -> KeyHeap {
@@ -109,40 +114,48 @@ impl KeyHeap {
         }
     }
 
+    /// Moves the entry at `k` up past the parents smaller than it (each moved down a place
+    /// into the hole it leaves).
     fn up(&mut self, mut k: usize) {
+        let e = self.heap[k];
         while k > 0 {
-            let parent = (k - 1) / 2;
-            if self.heap[k] <= self.heap[parent] {
+            let parent = (k - 1) / ARITY;
+            if e <= self.heap[parent] {
                 break;
             }
-            self.swap(k, parent);
+            self.put(k, self.heap[parent]);
             k = parent;
         }
+        self.put(k, e);
     }
 
+    /// Moves the entry at `k` down past its largest child while that child is larger.
     fn down(&mut self, mut k: usize) {
         let n = self.heap.len();
+        let e = self.heap[k];
         loop {
-            let (l, r) = (2 * k + 1, 2 * k + 2);
-            let mut big = k;
-            if l < n && self.heap[l] > self.heap[big] {
-                big = l;
-            }
-            if r < n && self.heap[r] > self.heap[big] {
-                big = r;
-            }
-            if big == k {
+            let first = ARITY * k + 1;
+            if first >= n {
                 break;
             }
-            self.swap(k, big);
+            let mut big = first;
+            for c in first + 1..(first + ARITY).min(n) {
+                if self.heap[c] > self.heap[big] {
+                    big = c;
+                }
+            }
+            if self.heap[big] <= e {
+                break;
+            }
+            self.put(k, self.heap[big]);
             k = big;
         }
+        self.put(k, e);
     }
 
-    fn swap(&mut self, a: usize, b: usize) {
-        self.heap.swap(a, b);
-        self.pos[self.heap[a].1 as usize] = a as u32;
-        self.pos[self.heap[b].1 as usize] = b as u32;
+    fn put(&mut self, k: usize, e: Entry) {
+        self.heap[k] = e;
+        self.pos[e.1 as usize] = k as u32;
     }
 }
 
