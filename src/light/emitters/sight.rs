@@ -12,16 +12,19 @@
 //! So before a gather each emitting patch casts a few cosine-distributed rays from random
 //! points on it ([`Kernel::learn_sight`]; [`SIGHT_PER_PATCH`] rays per patch of the model in
 //! all, shared by the emitters, between [`SIGHT_RAYS_MIN`] and [`SIGHT_RAYS`] each), and each
-//! side of each polygon remembers which emitters' rays reached it: light found from the
+//! side of each cell of the model (the patches facing one way whose centres lie in one cube of
+//! [`CELL`] mean patch sizes) remembers which emitters' rays reached it: light found from the
 //! emitters' end, as in bidirectional importance sampling of many lights (Wang & Åkerlund,
 //! *Bidirectional Importance Sampling for Unstructured Direct Illumination*, Eurographics
-//! 2009). A side that [`TRUSTED_HITS`] or more sight rays reached then draws the nodes of its
-//! cut that none of them came from at [`UNSEEN`] of the cut's probability
-//! ([`Emitters::sighted`]). Every emitter the cut can draw stays drawable and its density is
-//! used throughout (the light samples, the hemisphere rays' MIS weights), so the gather stays
-//! unbiased; a lamp missed by chance costs variance, not bias, and the thresholds keep that
-//! rare (a lamp giving a tenth of a trusted side's light is missed by all of its rays with
-//! probability e^(−4.8) < 1 %).
+//! 2009). A patch on a side that [`TRUSTED_HITS`] or more sight rays reached makes its cut
+//! splitting the nodes the side sees ([`SPLIT_UNSEEN`], [`Emitters::draw_shaped`]), and the
+//! nodes none of its sight rays came from keep at most [`UNSEEN`] of its draw together
+//! ([`Emitters::sighted`]). Every emitter the cut can draw stays drawable and the draw's
+//! density is used throughout (the light samples, the hemisphere rays' MIS weights), so the
+//! gather stays unbiased; a lamp missed by chance costs variance, not bias, and the thresholds
+//! keep that rare (a lamp giving a tenth of a trusted side's light is missed by all of its
+//! rays with probability e^(−4.8) < 1 %). Polygons were tried as the sides first: a building's
+//! are too small (8.7 patches each on the generated one) to be reached often enough.
 //!
 //! Reproducible: emitter e's rays come from (seed, [`Stream::Sight`], e), whatever thread
 //! casts them.
