@@ -42,6 +42,7 @@ use crate::mesh::Mesh;
 use crate::sample::PatchPoints;
 use glam::Vec3;
 pub(crate) use learn::Learned;
+pub(crate) use sight::Sight;
 
 /// At most this many nodes of the emitters' tree in a receiver's cut (each emitting patch is
 /// its own node of the cut when there are no more emitting patches than this).

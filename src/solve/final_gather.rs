@@ -54,7 +54,7 @@
 use super::estimate::{self, ErrorMetrics, Parts};
 use super::{rng_for, scalar, LightChannel, Solution, Stream, TracePoint};
 use crate::intersect::Intersector;
-use crate::light::emitters::Learned;
+use crate::light::emitters::{Learned, Sight};
 use crate::light::gather::{Ask, Gathered, Spot};
 use crate::light::{self, emission_and_reflectance, Kernel, LightParts, Rgb, Solved};
 use crate::mesh::spatial::{facing_class, space_order};
@@ -220,8 +220,10 @@ pub struct Gathers {
     /// Rounds so far, and their wall-clock seconds.
     rounds: u64,
     seconds: f64,
-    /// The emitters' sight rays cast before the rounds (`crate::light::emitters`).
+    /// The emitters' sight rays cast before the first round (`crate::light::emitters`), and
+    /// what they found, which the further rounds reuse.
     sight_rays: u64,
+    sight: Option<Sight>,
 }
 
 /// One gathered patch's error model: the shooting's variance and the gather's (of ρ·H's mean,
@@ -390,12 +392,23 @@ pub fn apply<I: Intersector>(
             group: inp.group.filter(|_| !sol.channels.is_empty()),
         };
         let mut kernel = Kernel::new(inp.mesh, inp.materials, inp.isect, solved, inp.sky);
-        let sight_rays = kernel.learn_sight(inp.seed);
         let mut gathers = match more {
-            Some(more) => regather(&kernel, inp.seed, more),
-            None => first_round(&kernel, inp.seed, inp.rays.max(4), sol),
+            Some(mut more) => {
+                if let Some(sight) = more.prior.sight.take() {
+                    kernel.emitters.set_sight(sight);
+                }
+                regather(&kernel, inp.seed, more)
+            }
+            None => {
+                let sight_rays = kernel.learn_sight(inp.seed);
+                let first = first_round(&kernel, inp.seed, inp.rays.max(4), sol);
+                Gathers {
+                    sight_rays,
+                    ..first
+                }
+            }
         };
-        gathers.sight_rays += sight_rays;
+        gathers.sight = kernel.emitters.take_sight();
         gathers
     };
     let c = combine(inp, sol, (&e, &rho), &area, &gathers);
@@ -701,6 +714,7 @@ mod tests {
             rounds: 0,
             seconds: 0.0,
             sight_rays: 0,
+            sight: None,
         };
         let now = (g.model[0].relative(1.0) + g.model[1].relative(1.0)) / 2.0;
         assert!((now - 0.055).abs() < 1e-9, "{now}");

@@ -138,6 +138,18 @@ pub(super) fn split_priority(node: &Cluster, reached: Option<&[u32]>) -> f64 {
 }
 
 impl Emitters {
+    /// Takes the sight cast for these emitters ([`Kernel::learn_sight`]), to be handed to the
+    /// kernel of a later gather round of the same solution ([`Emitters::set_sight`]) rather
+    /// than cast again (the same seed would cast the same rays).
+    pub(crate) fn take_sight(&mut self) -> Option<Sight> {
+        self.sight.take()
+    }
+
+    /// Gives these emitters a sight cast before ([`Emitters::take_sight`]).
+    pub(crate) fn set_sight(&mut self, sight: Sight) {
+        self.sight = Some(sight);
+    }
+
     /// The emitters that reached patch `i`'s side of its cell, if it is trusted.
     fn reached_by(&self, i: usize) -> Option<&[u32]> {
         self.sight.as_ref()?.reached(i)
