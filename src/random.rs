@@ -41,6 +41,9 @@ pub enum Stream {
     Luminaires,
     /// The emitters' sight rays before a gather (`u64::MAX − 8`, `light::emitters`).
     Sight,
+    /// The rays the first final gather adds to the patches its pilot gathered
+    /// (`u64::MAX − 9`, `solve::final_gather`).
+    TopUp,
 }
 
 /// Regather round k draws under `Stream::Gather`'s number less k times this.
@@ -61,6 +64,7 @@ impl Stream {
             Stream::Hidden => u64::MAX - 6,
             Stream::Luminaires => u64::MAX - 7,
             Stream::Sight => u64::MAX - 8,
+            Stream::TopUp => u64::MAX - 9,
         }
     }
 }
@@ -93,5 +97,6 @@ mod tests {
         assert_eq!(Stream::Hidden.id(), u64::MAX - 6);
         assert_eq!(Stream::Luminaires.id(), u64::MAX - 7);
         assert_eq!(Stream::Sight.id(), u64::MAX - 8);
+        assert_eq!(Stream::TopUp.id(), u64::MAX - 9);
     }
 }

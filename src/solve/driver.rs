@@ -172,6 +172,7 @@ pub fn shoot_with<I: Intersector>(
             shooting: &shooting,
             sky: sky.as_ref(),
             reference: hooks.reference.as_deref().map(Vec::as_slice),
+            pilot: cfg.first_gather_pilot(rays),
         };
         let gathers = final_gather::apply(&inputs, &mut sol, None, &mut on_trace);
         // An error target may add gather rounds to these (`passes`).
@@ -182,7 +183,8 @@ pub fn shoot_with<I: Intersector>(
     Ok(sol)
 }
 
-/// Rays per patch for the final gather: the settings' ([`SolveSettings::gather_rays_per_patch`]),
+/// Rays per patch for the final gather, the most a pilot may choose under an error target: the
+/// settings' ([`SolveSettings::gather_rays_per_patch`]),
 /// or, under `--max-time`, as many as the time left allows at the rate the shooting cast rays
 /// (a gather ray costing [`GATHER_RAY_COST`] shooting rays), down to [`MIN_BUDGET_GATHER`];
 /// `None` (no gather) when not even that fits. Only this clock budget makes the gather depend
@@ -196,7 +198,7 @@ fn gather_rays_within(
     let elapsed = start.elapsed().as_secs_f64();
     gather_rays_fitting(
         cfg,
-        cfg.first_gather_rays(),
+        cfg.gather_rays_per_patch(),
         patches,
         stats.rays as f64,
         elapsed,

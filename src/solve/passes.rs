@@ -11,9 +11,10 @@
 //! thrown away, so error against time keeps falling like 1/√rays for as long as the run is let.
 //!
 //! **The first pass** is the plain solve, final gather included, sized for the gather to make
-//! the estimate: without `--tolerance` it shoots at 1.4·E
-//! ([`super::settings::TARGET_TOLERANCE`]) and gathers half the rays per patch
-//! ([`super::settings::FIRST_GATHER_SHARE`]); when it meets E it is the result. Otherwise each
+//! the estimate: without `--tolerance` it shoots at 2·E
+//! ([`super::settings::TARGET_TOLERANCE`]), and a pilot on a sample of the patches picks the
+//! gather's rays per patch to land at [`ROUND_AIM`] of E (`final_gather`, module `pilot`);
+//! when it meets E it is the result. Otherwise each
 //! next pass is sized from the estimate: to reach E from e with R samples so far, about
 //! R·((e/E)^(1/p) − 1) more are needed, p the rate the estimate falls at (e ∝ R^−p). Pure
 //! sampling noise gives p = ½; where the gather's near paths or light still owed weigh in the
@@ -76,14 +77,7 @@ pub struct ErrorTarget {
 /// noisy and its rate of fall is known only roughly, and undershooting costs a further pass.
 pub const AIM: f64 = 0.85;
 
-/// A gather round aims at this fraction of the error target: its model predicts it closely
-/// (reached 1.03–1.07 × predicted on the generated buildings, 100 k to 10 M patches), and a
-/// round that misses is followed by a small one, not a whole pass. Whether to take a round
-/// rather than a pass is still judged at [`AIM`], where the passes' cost is reckoned: judged at
-/// this aim, rounds won where a further pass had been chosen (the converted furnished room:
-/// 2 passes and a round instead of 3 and a round, 2.93 % against Radiance instead of 2.58 %). At [`AIM`] a round after a
-/// near miss cost more than the first gather (10 M: 5.08 % → 4.55 % for 1.84 G rays).
-pub const ROUND_AIM: f64 = 0.9;
+pub use super::settings::ROUND_AIM;
 
 /// The rate p of e ∝ R^−p from two (samples, estimate) points, kept within [¼, ½]: ½ is pure
 /// sampling noise, and a rate below ¼ (an estimate barely moving, say from a noisy point) would
@@ -337,8 +331,10 @@ struct Passes<'a, I> {
     /// The first pass's samples and energy per ray: later passes are sized from them.
     r1: f64,
     c1: f64,
-    /// The first pass's gather rays, to cost a shooting pass's gather.
+    /// The first pass's gather rays, to cost a shooting pass's gather, and its rays per patch
+    /// (its pilot's choice), which later passes' gathers grow from.
     first_gather_rays: f64,
+    first_rays_per_patch: usize,
     /// The estimate of the result so far, its trace, the result and the passes it combines.
     m: ErrorMetrics,
     trace: Vec<TracePoint>,
@@ -390,6 +386,9 @@ impl<'a, I: Intersector> Passes<'a, I> {
         let unmet = m.weighted_percent > at.target;
         // The pass's gathers move to the base: nothing reads them from the pass again.
         let first_gathers = sols[0].shooting.as_mut().and_then(|s| s.gathers.take());
+        let first_rays_per_patch = first_gathers
+            .as_ref()
+            .map_or(cfg.first_gather_rays(), |g| g.first_rays());
         let base = match (gather, first_gathers) {
             (Some(_), Some(gathers)) if unmet => {
                 let (pre, _, parts) = combine(at.mesh, &at.area, &at.emission, &sols);
@@ -409,6 +408,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
             r1,
             c1,
             first_gather_rays,
+            first_rays_per_patch,
             m,
             trace,
             out,
@@ -582,7 +582,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
         let cfg = self.at.cfg;
         let mut scale = (so_far + samples(sol)) / self.r1;
         if self.gather.is_some() {
-            let wanted = (cfg.first_gather_rays() as f64 * scale).round() as usize;
+            let wanted = (self.first_rays_per_patch as f64 * scale).round() as usize;
             let elapsed = self.at.start.elapsed().as_secs_f64();
             let cast = so_far + samples(sol);
             let np = self.at.mesh.patches.len();
@@ -604,7 +604,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
         more: Option<(final_gather::Gathers, &[usize])>,
     ) -> (Solution, ErrorMetrics, Base) {
         let (cfg, hooks) = (self.at.cfg, self.at.hooks);
-        let rays = (cfg.first_gather_rays() as f64 * scale)
+        let rays = (self.first_rays_per_patch as f64 * scale)
             .round()
             .min(super::settings::MAX_GATHER_RAYS as f64) as usize;
         let shooting = final_gather::Shooting {
@@ -623,6 +623,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
             shooting: &shooting,
             sky: sky.as_ref(),
             reference: hooks.reference.as_deref().map(Vec::as_slice),
+            pilot: None,
         };
         let more = more.map(|(prior, extra)| final_gather::Regather { prior, extra });
         let gathers = final_gather::apply(&inputs, &mut sol, more, &mut |_| {});

@@ -34,15 +34,32 @@ pub const DEFAULT_ERROR_TARGET: f64 = 0.05;
 /// bounded time; `--error` lifts it): [`SolveSettings::error_bound`].
 pub const DEFAULT_ERROR_MAX_FACTOR: f64 = 8.0;
 /// With an error target E (`solve --error`, on by default) and no `--tolerance`, the first
-/// pass shoots at tolerance E × this (0.07 for the default 5 %) rather than the default
+/// pass shoots at tolerance E × this (0.1 for the default 5 %) rather than the default
 /// tolerance: its final gather then makes the estimate, and the shooting is its cache of the
-/// indirect light. Measured on the generated buildings (docs/results/ray-path.md): the 1 M
-/// building lands at 4.3 % in 148 s where tolerance 0.05 took 197 s (4.3 %) and 0.1 needed a
-/// second gather round (177 s, 4.4 %); on the 100 k one 0.07 and 0.1 give the same error per ray.
-pub const TARGET_TOLERANCE: f64 = 1.4;
-/// With an error target the first final gather casts this share of the rays per patch
-/// ([`SolveSettings::first_gather_rays`]); further rounds add rays where the error is.
-pub const FIRST_GATHER_SHARE: f64 = 0.5;
+/// indirect light. With the first gather sized by its pilot to land at 0.9·E, the 100 k-patch
+/// building reached 4.5 % against its reference for 26.5, 18.9 and 15.4 M rays at 1.4, 2 and
+/// 2.8 × E; the 1 M one took 105, 88 and 89 s (a gather ray costs about two shooting rays, and
+/// the shooting's count of shots hardly falls). 2 × keeps the shooting's estimate of the light
+/// still owed honest (at 4 × E the 100 k building's estimate fell 14 % under its error):
+/// docs/results/first-gather-pilot.md.
+pub const TARGET_TOLERANCE: f64 = 2.0;
+/// With an error target the first final gather's pilot casts this share of the rays per patch
+/// ([`SolveSettings::first_gather_rays`]) on a sample of the patches, and picks the rays per
+/// patch of the rest (`super::final_gather`), at most the settings' rays per patch. A pilot of
+/// 128 rays predicted too low an estimate for the 43–70 it chose on the 1 M-patch building
+/// (reached 1.09–1.11 × predicted); one of 64 chose 84 and reached 0.99 × (docs/results/
+/// first-gather-pilot.md).
+pub const FIRST_GATHER_SHARE: f64 = 0.25;
+/// A gather round aims at this fraction of the error target (`super::passes`), and so does the
+/// first gather, sized by its pilot ([`SolveSettings::first_gather_pilot`]): their models
+/// predict them closely (a round reached 1.03–1.07 × predicted on the generated buildings,
+/// 100 k to 10 M patches; the pilot 0.99–1.05 ×), and a round that misses is followed by a
+/// small one, not a whole pass. Whether to take a round rather than a pass is still judged at
+/// `passes::AIM`, where the passes' cost is reckoned: judged at this aim, rounds won where a
+/// further pass had been chosen (the converted furnished room: 2 passes and a round instead of
+/// 3 and a round, 2.93 % against Radiance instead of 2.58 %). At `passes::AIM` a round after a
+/// near miss cost more than the first gather (10 M: 5.08 % → 4.55 % for 1.84 G rays).
+pub const ROUND_AIM: f64 = 0.9;
 /// Rays per gathered patch (`--gather-rays`): half shadow rays to the emitters, half over the
 /// hemisphere (see [`super::final_gather`]).
 pub const DEFAULT_GATHER_RAYS: usize = 256;
@@ -288,10 +305,7 @@ impl SolveSettings {
     }
 
     /// Rays each patch gathers in the first final gather: [`Self::gather_rays_per_patch`], or
-    /// with an error target [`FIRST_GATHER_SHARE`] of them (at least 16): the target's gather
-    /// rounds (`passes`) then add rays where the estimate says the error is, so the first
-    /// gather need not be sized for the worst patch, and a model that meets the target with
-    /// fewer rays stops there.
+    /// with an error target those of its pilot, [`FIRST_GATHER_SHARE`] of them (at least 16).
     pub fn first_gather_rays(&self) -> usize {
         let all = self.gather_rays_per_patch();
         if self.error_target.is_some() {
@@ -299,6 +313,15 @@ impl SolveSettings {
         } else {
             all
         }
+    }
+
+    /// With an error target, the pilot that sizes the first final gather for [`ROUND_AIM`] of
+    /// it, its own rays at most `most` (the gather's rays per patch under `--max-time`).
+    pub fn first_gather_pilot(&self, most: usize) -> Option<super::final_gather::Pilot> {
+        self.error_target.map(|e| super::final_gather::Pilot {
+            goal: e * ROUND_AIM,
+            rays: self.first_gather_rays().min(most),
+        })
     }
 
     /// The samples after which an error target gives up ([`Self::error_max_factor`]), for a

@@ -85,3 +85,49 @@ fn a_bad_target_is_refused() {
         assert!(msg.contains("--error"), "{msg}");
     }
 }
+
+/// The first gather of an error target is sized by a pilot on a sample of the patches: a
+/// looser target gets fewer rays per patch, the estimate lands near what the pilot predicted,
+/// and the choice is the same on any thread count.
+#[test]
+fn a_pilot_sizes_the_first_gather_for_the_target() {
+    let (s, m) = scene_builder::project_scene("office.obj");
+    let plain = run(&s, &m, &SolveSettings::default());
+    let e0 = estimate_of(&plain);
+    let at = |target: f64, threads: Option<usize>| {
+        let cfg = SolveSettings {
+            error_target: Some(target),
+            ..SolveSettings::default()
+        };
+        crate::common::on_threads(threads, || run(&s, &m, &cfg))
+    };
+    let pilot_of = |sol: &Solution| {
+        let g = sol.stats.final_gather.expect("a final gather");
+        (g, g.pilot.expect("sized by a pilot"))
+    };
+    let (tight, loose) = (at(1.3 * e0, None), at(2.0 * e0, None));
+    let (gt, pt) = pilot_of(&tight);
+    let (gl, pl) = pilot_of(&loose);
+    assert!(pl.rays_per_patch < pt.rays_per_patch, "{pl:?} {pt:?}");
+    assert!(gl.rays < gt.rays, "{gl:?} {gt:?}");
+    // The pilot is a sample, at most half the patches gathered.
+    assert!(
+        pt.patches > 0 && 2 * pt.patches <= gt.patches,
+        "{pt:?} {gt:?}"
+    );
+    for (sol, p) in [(&tight, pt), (&loose, pl)] {
+        // Sized for its goal (the target's gather-round aim), where it could be met.
+        assert!((p.goal - 0.9 * sol.stats.error_target.unwrap().target).abs() < 1e-12);
+        assert!(p.predicted <= p.goal, "{p:?}");
+        // The first gather's estimate (the first trace point after it) near the prediction.
+        let first = sol.stats.trace[plain.stats.trace.len() - 1]
+            .estimate
+            .weighted_percent;
+        assert!(
+            (first / p.predicted - 1.0).abs() < 0.1,
+            "{first} against {p:?}"
+        );
+    }
+    assert_eq!(at(2.0 * e0, Some(1)).b, loose.b);
+    assert_eq!(at(2.0 * e0, Some(2)).b, loose.b);
+}

@@ -383,7 +383,7 @@ const SHAPING: &[Shaping] = &[
     shaping("luminaires", &["--luminaires", "lamps.csv"], &[]),
     shaping("scale", &["--scale", "0.5"], &[]),
     shaping("seed", &["--seed", "7"], &[]),
-    shaping("tolerance", &["--tolerance", "0.1"], &[]),
+    shaping("tolerance", &["--tolerance", "0.08"], &[]),
     shaping("energy-per-ray", &["--energy-per-ray", "0.5"], &[]),
     shaping("stop", &["--stop", "0.001"], &[]),
     shaping("polar-centres", &["--polar-centres"], &[]),

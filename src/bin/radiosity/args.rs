@@ -97,7 +97,7 @@ pub struct SamplingArgs {
     /// Relative sampling error wanted for a typical patch's radiosity. Sets the energy each ray
     /// carries (Sec. 2: rays in proportion to unshot energy): about patches/tolerance² rays in
     /// all, so halving it costs 4× the rays. Left out, a solve with an error target shoots its
-    /// first pass at 1.4× the error target, and its final gather makes the estimate
+    /// first pass at 2× the error target, and its final gather makes the estimate
     /// [default: 0.05; reference: 0.005].
     #[arg(long, allow_negative_numbers = true)]
     pub tolerance: Option<f64>,
@@ -129,8 +129,10 @@ pub struct SamplingArgs {
     #[arg(long, value_enum, default_value_t = OnOff::from(DEFAULT_FINAL_GATHER), value_name = "on|off")]
     pub final_gather: OnOff,
     /// Rays per gathered patch at the default tolerance, growing as 1/tolerance² with a finer
-    /// one (half to the lights, half over the hemisphere); with an error target the first
-    /// gather casts half of them, and further rounds add rays where the error is.
+    /// one (half to the lights, half over the hemisphere). With an error target, the most the
+    /// first gather casts: a pilot of a quarter of them on a sample of the patches picks the
+    /// fewest rays per patch it predicts to reach 0.9× the target, and further rounds add rays
+    /// where the error is.
     #[arg(long, default_value_t = DEFAULT_GATHER_RAYS, value_name = "N")]
     pub gather_rays: usize,
 }

@@ -62,9 +62,12 @@ use crate::mesh::Mesh;
 use crate::sample::PatchPoints;
 use crate::scene::Material;
 use crate::sky::Sky;
+pub use pilot::{Pilot, PilotSizing};
 use rayon::prelude::*;
 use std::borrow::Cow;
 use std::time::Instant;
+
+mod pilot;
 
 /// What the final gather did (`summary.json`: `final_gather`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -84,21 +87,26 @@ pub struct GatherStats {
     pub black_after: u64,
     /// Mean weight the shooting estimate kept in the gathered patches (0: all gather).
     pub mean_shooting_weight: f64,
+    /// How a pilot sized the first round (`solve --error`'s first pass), if one did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pilot: Option<PilotSizing>,
 }
 
 /// A shooting estimate this many combined σ from the gather's is biased, not noisy: kept out.
 pub const BIAS_Z: f64 = 4.0;
 
-/// Patch `i`'s gather of `rays` rays through `kernel`; `round` 0 is the first, later rounds
-/// ([`Gathers::plan`]) draw independent random numbers to be pooled with it.
+/// Patch `i`'s gather of `rays` rays through `kernel`, its random numbers from `stream`: the
+/// first round's ([`Stream::Gather`]), a later round's ([`Gathers::plan`]) or the first
+/// round's top-up of its pilot's patches ([`Stream::TopUp`]) draw independent numbers, to be
+/// pooled.
 fn gather_patch<I: Intersector>(
     kernel: &Kernel<'_, I>,
     seed: u64,
-    (i, rays, round): (usize, usize, u64),
+    (i, rays, stream): (usize, usize, Stream),
     learned: &mut Learned,
 ) -> Gathered {
     let points = PatchPoints::new(kernel.mesh, i);
-    let mut rng = rng_for(seed, Stream::Regather(round), i as u64);
+    let mut rng = rng_for(seed, stream, i as u64);
     let at = |u: f32, v: f32| points.at(u, v);
     let spot = Spot {
         patch: i,
@@ -119,7 +127,7 @@ fn gather_patch<I: Intersector>(
 /// ([`Learned`]).
 const LEARNING_RUN: usize = 256;
 
-/// Gathers `todo[k]` with `rays(k)` rays (none when 0) in round `round`: in parallel over runs
+/// Gathers `todo[k]` with `rays(k)` rays (none when 0) from `stream`: in parallel over runs
 /// of neighbouring patches facing one way ([`crate::mesh::spatial::space_order`], so the runs
 /// do not depend on the order of the model's faces), each patch of a run learning from those
 /// before it which lamps it sees ([`Learned`]). Results in the order of `todo`.
@@ -128,7 +136,7 @@ fn gather_runs<I: Intersector>(
     seed: u64,
     todo: &[usize],
     rays: impl Fn(usize) -> usize + Sync,
-    round: u64,
+    stream: Stream,
 ) -> Vec<Option<Gathered>> {
     let mesh = kernel.mesh;
     let order = space_order(mesh, todo);
@@ -156,7 +164,7 @@ fn gather_runs<I: Intersector>(
                     let r = rays(k as usize);
                     let i = todo[k as usize];
                     let g =
-                        (r > 0).then(|| gather_patch(kernel, seed, (i, r, round), &mut learned));
+                        (r > 0).then(|| gather_patch(kernel, seed, (i, r, stream), &mut learned));
                     out.push((k, g));
                 }
             }
@@ -224,6 +232,10 @@ pub struct Gathers {
     /// what they found, which the further rounds reuse.
     sight_rays: u64,
     sight: Option<Sight>,
+    /// Rays per patch of the first round (the pilot's choice when it was sized by one), and
+    /// what the pilot found.
+    first_rays: usize,
+    pilot: Option<PilotSizing>,
 }
 
 /// One gathered patch's error model: the shooting's variance and the gather's (of ρ·H's mean,
@@ -268,6 +280,11 @@ pub struct RegatherPlan {
 }
 
 impl Gathers {
+    /// Rays per patch of the first round: later passes grow theirs from it.
+    pub fn first_rays(&self) -> usize {
+        self.first_rays
+    }
+
     /// Rays cast by every round so far.
     pub fn rays(&self) -> u64 {
         self.got.iter().map(|g| g.rays).sum::<u64>() + self.sight_rays
@@ -365,6 +382,9 @@ pub struct GatherInputs<'a, I> {
     pub sky: Option<&'a Sky>,
     /// The reference solution the trace measures the error against, when there is one.
     pub reference: Option<&'a [[f64; 3]]>,
+    /// A first round sized by a pilot to land the estimate at a goal (`solve --error`'s first
+    /// pass), `rays` then its most rays per patch.
+    pub pilot: Option<Pilot>,
 }
 
 /// Gathers the patches that need it (see the module notes) and rewrites `sol.b` and
@@ -401,7 +421,11 @@ pub fn apply<I: Intersector>(
             }
             None => {
                 let sight_rays = kernel.learn_sight(inp.seed);
-                let first = first_round(&kernel, inp.seed, inp.rays.max(4), sol);
+                let todo = to_gather(&kernel, sol);
+                let first = match inp.pilot {
+                    Some(p) => pilot::sized_round(&kernel, inp, todo, sol, p),
+                    None => first_round(&kernel, inp.seed, todo, inp.rays.max(4)),
+                };
                 Gathers {
                     sight_rays,
                     ..first
@@ -427,6 +451,7 @@ pub fn apply<I: Intersector>(
         } else {
             c.weight_sum / todo_len as f64
         },
+        pilot: gathers.pilot,
     };
     sol.b = c.b;
     sol.channels = c.channels;
@@ -473,14 +498,9 @@ fn black(b: &[[f64; 3]], e: &[Rgb], rho: &[Rgb], mesh: &Mesh) -> u64 {
         .count() as u64
 }
 
-/// The first round: every patch that reflects gathers `rays` rays, but the sides that face
-/// the void.
-fn first_round<I: Intersector>(
-    kernel: &Kernel<'_, I>,
-    seed: u64,
-    rays: usize,
-    sol: &Solution,
-) -> Gathers {
+/// The patches the first round gathers: every patch that reflects, but the sides that face
+/// the void and the hidden sides the shooting left black.
+fn to_gather<I: Intersector>(kernel: &Kernel<'_, I>, sol: &Solution) -> Vec<usize> {
     let (mesh, e, rho) = (kernel.mesh, &kernel.sol.e, &kernel.sol.rho);
     // A side of a two-sided surface that the shooting left dark while its other side is lit
     // faces the void or the inside of an object (docs/design.md §7): nothing to gather there.
@@ -493,10 +513,19 @@ fn first_round<I: Intersector>(
     // A hidden side (inside a closed solid, `crate::mesh::Hidden`) the shooting brought no
     // light: none can reach it, so no rays are cast for it.
     let hidden = |i: usize| mesh.hidden.side(mesh, i) && reflected(&sol.b, e, i) <= 0.0;
-    let todo: Vec<usize> = (0..mesh.patches.len())
+    (0..mesh.patches.len())
         .filter(|&i| !faces_void(i) && !hidden(i) && light::scalar(rho[i]) > 0.0)
-        .collect();
-    let got: Vec<Gathered> = gather_runs(kernel, seed, &todo, |_| rays, 0)
+        .collect()
+}
+
+/// The first round of `rays` rays on every patch of `todo`.
+fn first_round<I: Intersector>(
+    kernel: &Kernel<'_, I>,
+    seed: u64,
+    todo: Vec<usize>,
+    rays: usize,
+) -> Gathers {
+    let got: Vec<Gathered> = gather_runs(kernel, seed, &todo, |_| rays, Stream::Gather)
         .into_iter()
         .map(|g| g.expect("every patch asks rays"))
         .collect();
@@ -504,6 +533,7 @@ fn first_round<I: Intersector>(
         asked: vec![rays; todo.len()],
         todo,
         got,
+        first_rays: rays,
         ..Gathers::default()
     }
 }
@@ -515,7 +545,13 @@ fn regather<I: Intersector>(kernel: &Kernel<'_, I>, seed: u64, more: Regather) -
     prior.rounds += 1;
     let round = prior.rounds;
     let todo = &prior.todo;
-    let fresh = gather_runs(kernel, seed, todo, |k| extra[todo[k]], round);
+    let fresh = gather_runs(
+        kernel,
+        seed,
+        todo,
+        |k| extra[todo[k]],
+        Stream::Regather(round),
+    );
     for (k, g2) in fresh.into_iter().enumerate() {
         if let Some(g2) = g2 {
             let i = prior.todo[k];
@@ -715,6 +751,8 @@ mod tests {
             seconds: 0.0,
             sight_rays: 0,
             sight: None,
+            first_rays: 256,
+            pilot: None,
         };
         let now = (g.model[0].relative(1.0) + g.model[1].relative(1.0)) / 2.0;
         assert!((now - 0.055).abs() < 1e-9, "{now}");
