@@ -624,8 +624,16 @@ impl Summary {
 
     /// What the final gather did, in a few words.
     pub fn gather_line(g: &crate::solve::final_gather::GatherStats) -> String {
+        let pilot = g.pilot.map_or(String::new(), |p| {
+            format!(
+                "; {} rays a patch, chosen by a pilot of {} patches for an estimate of {:.2} %",
+                p.rays_per_patch,
+                p.patches,
+                100.0 * p.predicted
+            )
+        });
         format!(
-            "final gather of {} patches ({} rays, {:.2} s; black patches {} → {})",
+            "final gather of {} patches ({} rays, {:.2} s; black patches {} → {}{pilot})",
             g.patches, g.rays, g.seconds, g.black_before, g.black_after
         )
     }
