@@ -23,7 +23,7 @@
 //! The choice depends on the model and the seed only, not on the threads.
 
 use super::{
-    combine, first_round, gather_runs, pooled, GatherInputs, Gathered, Gathers, Solution,
+    first_round, gather_runs, pooled, weigh, GatherInputs, Gathered, Gathers, PatchModel, Solution,
     LEARNING_RUN,
 };
 use crate::intersect::Intersector;
@@ -152,14 +152,10 @@ fn choose_rays<I: Intersector>(
     (goal, max_rays): (f64, usize),
 ) -> (usize, f64) {
     let mesh = kernel.mesh;
-    let area: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
-    let probe = Gathers {
-        todo: sample.to_vec(),
-        got: first.to_vec(),
-        ..Gathers::default()
-    };
     let light = (&kernel.sol.e[..], &kernel.sol.rho[..]);
-    let model = combine(inp, sol, light, &area, &probe).model;
+    let model: Vec<PatchModel> = (sample.iter().zip(first))
+        .map(|(&i, g)| weigh(inp.shooting, &sol.b, light, mesh.patches[i].area, (i, g)).model)
+        .collect();
     // The patches not gathered keep the shooting's error.
     let parts = &inp.shooting.parts;
     let mut in_todo = vec![false; mesh.patches.len()];
