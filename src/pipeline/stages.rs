@@ -164,6 +164,12 @@ pub const LIT_BACKS_RAYS: f64 = 4e6;
 /// as many shots as the solve itself.
 pub const LIT_BACKS_UNSHOT: f64 = 0.05;
 
+/// Past this many surface patches the probe runs on a coarser mesh of the same scene, of
+/// about this many patches (`probe_model`): where light meets backs is decided polygon by
+/// polygon, and on the model's own mesh the probe's shots grow with its patches (a
+/// million-patch building took 2.2 M shots for 6 M rays, most of them one ray each).
+pub const LIT_BACKS_PROBE_PATCHES: usize = 100_000;
+
 /// The loosest tolerance a solve takes (`SolveSettings::check`: under 1): past about
 /// [`LIT_BACKS_RAYS`] surface patches the probe's rays grow as the patches, one a patch.
 const LIT_BACKS_LOOSEST: f64 = 0.99;
@@ -172,10 +178,14 @@ const LIT_BACKS_LOOSEST: f64 = 0.99;
 /// the surface patches would make it cast more than [`LIT_BACKS_RAYS`] (up to
 /// [`LIT_BACKS_LOOSEST`]).
 fn lit_backs_tolerance(mesh: &crate::mesh::Mesh) -> f64 {
-    let n = (0..mesh.patches.len())
+    lit_backs_tolerance_for(surface_patches(mesh) as f64)
+}
+
+/// The patches of `mesh` that are not back twins.
+fn surface_patches(mesh: &crate::mesh::Mesh) -> usize {
+    (0..mesh.patches.len())
         .filter(|&i| mesh.is_surface(i))
-        .count();
-    lit_backs_tolerance_for(n as f64)
+        .count()
 }
 
 /// [`lit_backs_tolerance`] for `n` surface patches.
@@ -193,13 +203,28 @@ fn lit_backs_tolerance_for(n: f64) -> f64 {
 /// surfaces are all two-sided, sees them. Rays
 /// that left a covered part of their shooter are not cast (`crate::mesh::Contacts`) or carry
 /// nothing (`crate::mesh::Hidden`), so they make no back patches. The hidden sides are probed
-/// again once the back patches exist. The solve proper runs after, on the new mesh.
+/// again once the back patches exist. The solve proper runs after, on the new mesh. Past
+/// [`LIT_BACKS_PROBE_PATCHES`] surface patches the first shooting runs on a coarser cut of the
+/// scene (`probe_model`).
 pub fn lit_backs(
     job: &SolveJob,
     model: &mut Model,
     isect: Option<&(AnyIntersector, Selection)>,
     progress: &Progress,
     log: &mut impl FnMut(&str),
+) -> Result<Option<LitBacks>, Error> {
+    lit_backs_probing(job, model, isect, progress, log, LIT_BACKS_PROBE_PATCHES)
+}
+
+/// [`lit_backs`], its first shooting on a coarser cut of the scene past `most` surface patches
+/// (tests and studies set it; the solve's is [`LIT_BACKS_PROBE_PATCHES`]).
+pub fn lit_backs_probing(
+    job: &SolveJob,
+    model: &mut Model,
+    isect: Option<&(AnyIntersector, Selection)>,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+    most: usize,
 ) -> Result<Option<LitBacks>, Error> {
     let s = &job.settings;
     let Some((isect, _)) = isect else {
@@ -210,15 +235,24 @@ pub fn lit_backs(
     }
     progress.phase("looking for faces lit from behind");
     let t = Instant::now();
+    let coarse = probe_model(job, model, most)?;
+    let (probed, probe_isect) = match &coarse {
+        Some((m, Some((i, _)))) => (m, i),
+        _ => (&*model, isect),
+    };
+    // On a coarser mesh, the rays the model's own would have had (n/τ² rays for n patches).
+    let surfaces = |m: &crate::mesh::Mesh| surface_patches(m) as f64;
+    let coarser = (surfaces(&probed.mesh) / surfaces(&model.mesh)).sqrt();
     let probe = crate::solve::SolveSettings {
-        tolerance: s.solve.tolerance.max(lit_backs_tolerance(&model.mesh)),
+        tolerance: (s.solve.tolerance.max(lit_backs_tolerance(&model.mesh)) * coarser)
+            .min(LIT_BACKS_LOOSEST),
         energy_per_ray: None,
         error_target: None,
         final_gather: false,
         stop_unshot: Some(LIT_BACKS_UNSHOT),
         ..s.solve.clone()
     };
-    let sol = model.solve(Some(isect), &probe, &Default::default(), |_| {})?;
+    let sol = probed.solve(Some(probe_isect), &probe, &Default::default(), |_| {})?;
     // What met backs is measured against the light that came to rest in the model before the
     // probe stopped (a sky's light that missed it never was in it): the share the rest would
     // leave on backs too.
@@ -227,11 +261,11 @@ pub fn lit_backs(
     let rested =
         (scalar(&energy.emitted) - scalar(&energy.unshot) - scalar(&energy.distant_missed))
             .max(f64::MIN_POSITIVE);
-    let mesh = &model.mesh;
+    let mesh = &probed.mesh;
     let mut per_polygon: std::collections::BTreeMap<u32, f64> = Default::default();
     for (i, &phi) in sol.back.iter().enumerate() {
         let p = &mesh.patches[i];
-        let m = &model.scene.materials[p.material as usize];
+        let m = &probed.scene.materials[p.material as usize];
         if phi > 0.0 && !m.is_emitter() {
             *per_polygon.entry(p.polygon).or_default() += phi;
         }
@@ -242,8 +276,10 @@ pub fn lit_backs(
         back_fraction: total / rested,
         shots: sol.stats.shots,
         rays: sol.stats.rays,
+        probe_patches: probed.mesh.patches.len(),
         ..LitBacks::default()
     };
+    drop(coarse);
     if total >= LIT_BACKS_MIN * rested {
         let mut ranked: Vec<(u32, f64)> = per_polygon.into_iter().collect();
         ranked.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
@@ -271,6 +307,37 @@ pub fn lit_backs(
     }
     out.seconds = t.elapsed().as_secs_f64();
     Ok(Some(out))
+}
+
+/// The model [`lit_backs`] probes when it has more than `most` surface patches: the same
+/// scene cut at a patch size √(n / `most`) times its own, so about `most` patches, with its
+/// own intersector, contacts and hidden sides (the rays that leave a covered part carry no
+/// light in the probe either). The polygons are the scene's, so what the probe finds on them
+/// is given back to the model's own mesh. `None`: the model's own mesh is probed.
+fn probe_model(
+    job: &SolveJob,
+    model: &Model,
+    most: usize,
+) -> Result<Option<(Model, SolveIntersector)>, Error> {
+    let n = surface_patches(&model.mesh);
+    if n <= most {
+        return Ok(None);
+    }
+    let s = &job.settings;
+    let opts = crate::mesh::MeshOptions {
+        patch_size: Some(model.mesh.patch_size * (n as f32 / most as f32).sqrt()),
+        two_sided: false,
+        one_sided: false,
+        uniform_patches: true,
+    };
+    let mut coarse = Model::from_scene(model.scene.clone(), &opts)?;
+    let isect = coarse.intersector_for(s.solve.method, s.intersector)?;
+    let Some((i, _)) = &isect else {
+        return Ok(None);
+    };
+    coarse.mesh.contacts = coarse.mesh.find_contacts();
+    coarse.find_hidden(i, s.solve.seed);
+    Ok(Some((coarse, isect)))
 }
 
 /// Solve: runs the method with the job's hooks (reference, per-light channels, checkpoints,

@@ -459,6 +459,9 @@ pub struct LitBacks {
     /// The first shooting's shots and rays.
     pub shots: u64,
     pub rays: u64,
+    /// Patches of the mesh the first shooting ran on: the model's own, or past
+    /// `pipeline::stages::LIT_BACKS_PROBE_PATCHES` surface patches a coarser cut of the scene.
+    pub probe_patches: usize,
 }
 
 /// Sides no light can reach (`mesh::Hidden`; `summary.json`: `hidden`): the patches whose side
