@@ -18,6 +18,8 @@
 //! gathered as any other), it is counted apart from the black patches, and a shooting ray that
 //! meets a hidden back has left a covered part of its shooter (the floor under the cabinet):
 //! it carries no light, and the shot's flux goes out through its other rays (`solve::ray_shots`).
+//! That back, a one-sided patch's, is probed only when a ray first meets it ([`back_enclosed`]):
+//! [`find`] probes the fronts and the backs that are sides of twins.
 //!
 //! **Limits.** A solid wound the wrong way round (mixed winding) is not closed to this test;
 //! its inside is taken as air (a cost in rays, never a lost light). A patch only partly covered
@@ -37,24 +39,36 @@ use rayon::prelude::*;
 pub const PROBES: usize = 16;
 
 /// Finds the hidden sides of `mesh`'s surface patches. `open[j]`: surface patch j lets light
-/// through (glazing), so a ray meeting it is in the air.
+/// through (glazing), so a ray meeting it is in the air. The back of a one-sided patch is left
+/// to be probed when a ray meets it ([`back_enclosed`], through `Hidden::back_of`).
 pub fn find<I: Intersector>(mesh: &Mesh, isect: &I, open: &[bool], seed: u64) -> Hidden {
     let eps_floor = mesh.ray_offset_floor();
     let grid = PolarGrid::for_samples(PROBES as f64);
-    let sides: Vec<(bool, bool)> = (0..mesh.patches.len())
+    let sides: Vec<(bool, Option<bool>)> = (0..mesh.patches.len())
         .into_par_iter()
         .map(|i| {
             if !mesh.is_surface(i) {
-                return (false, false);
+                return (false, Some(false));
             }
             let probe = |back: bool| enclosed(mesh, isect, open, &grid, i, back, seed, eps_floor);
-            (probe(false), probe(true))
+            let twin = mesh.receiver(i as u32, true).is_some();
+            (probe(false), twin.then(|| probe(true)))
         })
         .collect();
-    Hidden {
-        front: sides.iter().map(|s| s.0).collect(),
-        back: sides.iter().map(|s| s.1).collect(),
-    }
+    Hidden::new(
+        sides.iter().map(|s| s.0).collect(),
+        sides.iter().map(|s| s.1).collect(),
+        open.to_vec(),
+        (seed, eps_floor),
+    )
+}
+
+/// Whether the back of surface patch `j` is hidden, probed now with what `find` kept in
+/// `mesh.hidden` (the same rays `find` would have cast for it, so the same answer).
+pub fn back_enclosed<I: Intersector>(mesh: &Mesh, isect: &I, j: usize) -> bool {
+    let h = &mesh.hidden;
+    let grid = PolarGrid::for_samples(PROBES as f64);
+    enclosed(mesh, isect, &h.open, &grid, j, true, h.seed, h.eps_floor)
 }
 
 // Eight arguments: the probe of one side needs the mesh, its intersector, the glazing, the

@@ -21,8 +21,10 @@
 //! depend on the thread count.
 
 use super::books::State;
+use super::ray_shots::RayCaster;
 use super::{rng_for, Stream};
-use crate::mesh::{Hidden, Mesh};
+use crate::intersect::Intersector;
+use crate::mesh::Mesh;
 use crate::sample::hemicube::{Hemicube, HemicubeBuffer, ShotWork};
 use crate::sample::Frame;
 use rand::Rng;
@@ -162,8 +164,18 @@ impl CubeShooter {
 /// back (`mesh::Hidden`: the cube's centre is covered from there, inside a solid) carry
 /// nothing, the other cells' factors scaled up by 1 / (1 − their share), unless every cell is
 /// covered (then the shot is absorbed on those backs, as before the test).
-pub(super) fn apply(st: &mut State, shot: &CubeShot, hits: &CubeHits, hidden: &Hidden) {
-    let is_covered = |j: u32, back: bool| back && hidden.back_of(j as usize);
+/// A back is probed the first time a cell sees it (`Hidden::back_of`), with the solve's
+/// intersector, `caster`'s; the hemi-cube methods have none, and find no hidden sides.
+pub(super) fn apply<I: Intersector>(
+    st: &mut State,
+    shot: &CubeShot,
+    hits: &CubeHits,
+    mesh: &Mesh,
+    caster: Option<&RayCaster<'_, I>>,
+) {
+    let back_hidden =
+        |j: usize| (mesh.hidden).back_of(j, || caster.is_some_and(|c| c.back_enclosed(j)));
+    let is_covered = |j: u32, back: bool| back && back_hidden(j as usize);
     let covered: f64 = (hits.ff.iter())
         .filter(|&&(j, _, back)| is_covered(j, back))
         .map(|&(_, f, _)| f)

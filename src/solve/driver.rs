@@ -643,7 +643,8 @@ impl<'a, I: Intersector> Driver<'a, I> {
             shooter.cast(self.mesh, self.cfg.seed, &wave, &mut self.cube_hits);
             for (shot, h) in wave.iter().zip(&self.cube_hits) {
                 self.switch.record(shot.cube.cell_count(), h);
-                cube_shots::apply(&mut self.st, shot, h, &self.mesh.hidden);
+                let caster = self.caster.as_ref();
+                cube_shots::apply(&mut self.st, shot, h, self.mesh, caster);
             }
             self.st.finish_batch();
             self.stats.hemicube_shots += wave.len() as u64;

@@ -14,6 +14,7 @@
 
 use super::books::State;
 use super::{rng_for, scalar, Stream};
+use crate::intersect::hidden::back_enclosed;
 use crate::intersect::{Intersector, Ray};
 use crate::mesh::Mesh;
 use crate::sample::PatchPoints;
@@ -173,6 +174,12 @@ pub(super) fn carried(st: &mut State, phi: &[f64; 3], tint: Option<[f64; 3]>) ->
 }
 
 impl<'a, I: Intersector> RayCaster<'a, I> {
+    /// Whether the back of surface patch `j` is hidden, probed with this caster's intersector
+    /// (`intersect::hidden::back_enclosed`; what `Hidden::back_of` asks the first time).
+    pub fn back_enclosed(&self, j: usize) -> bool {
+        back_enclosed(self.mesh, self.isect, j)
+    }
+
     pub fn new(mesh: &'a Mesh, isect: &'a I, seed: u64, jitter: bool) -> Self {
         RayCaster {
             mesh,
@@ -296,7 +303,9 @@ impl<'a, I: Intersector> RayCaster<'a, I> {
                         Some(r) => r,
                         None if own
                             .is_some_and(|o| !self.lights.get(o).copied().unwrap_or(false))
-                            && self.mesh.hidden.back_of(h.patch as usize) =>
+                            && self.mesh.hidden.back_of(h.patch as usize, || {
+                                back_enclosed(self.mesh, self.isect, h.patch as usize)
+                            }) =>
                         {
                             COVERED
                         }

@@ -148,6 +148,63 @@ fn a_face_lying_on_another_covers_it_and_only_where_it_lies() {
     assert_eq!(c.len(), 2);
 }
 
+/// The back of a one-sided face is probed when first asked (`Hidden::back_of`), not by
+/// `find`: a box standing on a floor has its bottom's back (inside the box) hidden and the
+/// floor's back (under the model, open) not, whichever is asked first and on whichever thread;
+/// a clone keeps what was found, and a back never asked is never probed.
+#[test]
+fn the_backs_of_one_sided_faces_are_probed_when_first_asked() {
+    use radiosity::intersect::embree::EmbreeScene;
+    use radiosity::intersect::hidden::{back_enclosed, find};
+    let mut s = scene("backs", vec![material("m", 0.5, 0.0)]);
+    quad(
+        &mut s,
+        [
+            vec3(0., 0., 0.),
+            vec3(0., 0., 2.),
+            vec3(2., 0., 2.),
+            vec3(2., 0., 0.),
+        ],
+        0,
+    );
+    block(&mut s, vec3(0.2, 0.0, 0.2), vec3(0.7, 0.2, 0.7), 0);
+    let mut mesh: Mesh = mesh_at(&s, Some(4.0));
+    mesh.contacts = mesh.find_contacts();
+    let isect = EmbreeScene::build(&mesh, |_| true).unwrap();
+    let open = vec![false; mesh.patches.len()];
+    mesh.hidden = find(&mesh, &isect, &open, 1);
+    let at = |up: bool| {
+        (0..mesh.patches.len())
+            .find(|&i| {
+                (mesh.patches[i].normal.y > 0.9) == up && mesh.patches[i].centre.y.abs() < 1e-6
+            })
+            .unwrap()
+    };
+    let (floor, bottom) = (at(true), at(false));
+    let probes = std::sync::atomic::AtomicUsize::new(0);
+    let ask = |m: &Mesh, j: usize| {
+        m.hidden.back_of(j, || {
+            probes.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            back_enclosed(m, &isect, j)
+        })
+    };
+    let copy = mesh.clone();
+    assert!(ask(&mesh, bottom), "the box's bottom faces into the box");
+    assert!(!ask(&mesh, floor), "the floor's back is under the model");
+    assert_eq!(probes.load(std::sync::atomic::Ordering::Relaxed), 2);
+    // Asked again: what was found, no probe.
+    assert!(ask(&mesh, bottom) && !ask(&mesh, floor));
+    assert_eq!(probes.load(std::sync::atomic::Ordering::Relaxed), 2);
+    // The copy made before, asked in the other order from two threads: the same answers.
+    let (f, b) = rayon::join(|| ask(&copy, floor), || ask(&copy, bottom));
+    assert!(!f && b);
+    assert_eq!(probes.load(std::sync::atomic::Ordering::Relaxed), 4);
+    // A clone made after keeps what was found.
+    let later = mesh.clone();
+    assert!(ask(&later, bottom) && !ask(&later, floor));
+    assert_eq!(probes.load(std::sync::atomic::Ordering::Relaxed), 4);
+}
+
 /// A room 4 × 2.5 × 4 with a wall across it built as two overlapping boxes (the overlap's faces
 /// are buried) against the same wall as one box: the buried faces are reported hidden and are
 /// black, the gather casts no rays for them, and the faces one can see come out the same.
