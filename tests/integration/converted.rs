@@ -112,11 +112,10 @@ fn on_floor(r: &Row) -> bool {
     r.centre.y.abs() < 1e-4 && r.normal.y > 0.9
 }
 
-#[test]
-fn a_face_lying_on_another_covers_it_and_only_where_it_lies() {
+/// A floor 2 × 2 facing up, a box 0.5 × 0.2 × 0.5 standing on it (bottom facing down, on the
+/// floor).
+fn box_on_a_floor() -> radiosity::scene::Scene {
     let mut s = scene("contact", vec![material("m", 0.5, 0.0)]);
-    // A floor 2 × 2 facing up, a box 0.5 × 0.2 × 0.5 standing on it (bottom facing down, on
-    // the floor), a second box floating 1 cm above it (no contact).
     quad(
         &mut s,
         [
@@ -128,12 +127,24 @@ fn a_face_lying_on_another_covers_it_and_only_where_it_lies() {
         0,
     );
     block(&mut s, vec3(0.2, 0.0, 0.2), vec3(0.7, 0.2, 0.7), 0);
+    s
+}
+
+/// The patch at height 0 facing up (the floor) or down (the box's bottom).
+fn level_face(mesh: &Mesh, up: bool) -> usize {
+    (0..mesh.patches.len())
+        .find(|&i| (mesh.patches[i].normal.y > 0.9) == up && mesh.patches[i].centre.y.abs() < 1e-6)
+        .unwrap()
+}
+
+#[test]
+fn a_face_lying_on_another_covers_it_and_only_where_it_lies() {
+    // The box on the floor, and a second box floating 1 cm above the floor (no contact).
+    let mut s = box_on_a_floor();
     block(&mut s, vec3(1.2, 0.01, 1.2), vec3(1.7, 0.2, 1.7), 0);
     let mesh: Mesh = mesh_at(&s, Some(4.0));
     let c = mesh.find_contacts();
-    let floor = (0..mesh.patches.len())
-        .find(|&i| mesh.patches[i].normal.y > 0.9 && mesh.patches[i].centre.y.abs() < 1e-6)
-        .unwrap();
+    let floor = level_face(&mesh, true);
     assert!(c.covers(floor, vec3(0.45, 0.0, 0.45)));
     assert!(!c.covers(floor, vec3(0.9, 0.0, 0.45)), "beside the box");
     assert!(
@@ -141,9 +152,7 @@ fn a_face_lying_on_another_covers_it_and_only_where_it_lies() {
         "under the floating box"
     );
     // The box's bottom is covered by the floor, and only the two faces are in contact.
-    let bottom = (0..mesh.patches.len())
-        .find(|&i| mesh.patches[i].normal.y < -0.9 && mesh.patches[i].centre.y.abs() < 1e-6)
-        .unwrap();
+    let bottom = level_face(&mesh, false);
     assert!(c.covers(bottom, vec3(0.45, 0.0, 0.45)));
     assert_eq!(c.len(), 2);
 }
@@ -156,31 +165,12 @@ fn a_face_lying_on_another_covers_it_and_only_where_it_lies() {
 fn the_backs_of_one_sided_faces_are_probed_when_first_asked() {
     use radiosity::intersect::embree::EmbreeScene;
     use radiosity::intersect::hidden::{back_enclosed, find};
-    let mut s = scene("backs", vec![material("m", 0.5, 0.0)]);
-    quad(
-        &mut s,
-        [
-            vec3(0., 0., 0.),
-            vec3(0., 0., 2.),
-            vec3(2., 0., 2.),
-            vec3(2., 0., 0.),
-        ],
-        0,
-    );
-    block(&mut s, vec3(0.2, 0.0, 0.2), vec3(0.7, 0.2, 0.7), 0);
-    let mut mesh: Mesh = mesh_at(&s, Some(4.0));
+    let mut mesh: Mesh = mesh_at(&box_on_a_floor(), Some(4.0));
     mesh.contacts = mesh.find_contacts();
     let isect = EmbreeScene::build(&mesh, |_| true).unwrap();
     let open = vec![false; mesh.patches.len()];
     mesh.hidden = find(&mesh, &isect, &open, 1);
-    let at = |up: bool| {
-        (0..mesh.patches.len())
-            .find(|&i| {
-                (mesh.patches[i].normal.y > 0.9) == up && mesh.patches[i].centre.y.abs() < 1e-6
-            })
-            .unwrap()
-    };
-    let (floor, bottom) = (at(true), at(false));
+    let (floor, bottom) = (level_face(&mesh, true), level_face(&mesh, false));
     let probes = std::sync::atomic::AtomicUsize::new(0);
     let ask = |m: &Mesh, j: usize| {
         m.hidden.back_of(j, || {
