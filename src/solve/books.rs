@@ -3,17 +3,34 @@
 //! ([`super::ray_shots`]) and the hemi-cube shots ([`super::cube_shots`]), so every method
 //! keeps the same books and stops by the same criterion (Sec. 3, [`super::stopping`]).
 //!
-//! Picking a shooter costs O(log patches): indexed binary heaps, one by unshot flux (who
-//! shoots next) and one by unshot radiosity (the stopping criterion), never a scan. A patch
-//! is in each at most once and moves when its key changes (an earlier design pushed a new
-//! entry per change and skipped stale ones: on a million patches a sixth of the shooting's
-//! time went into popping them).
+//! Picking a shooter costs O(log patches): indexed 4-ary heaps ([`super::key_heap`]), one by
+//! unshot flux (who shoots next) and one by unshot radiosity (the stopping criterion), not a
+//! scan per shot. A patch is in each at most once and moves when its key changes (an earlier design
+//! pushed a new entry per change and skipped stale ones: on a million patches a sixth of the
+//! shooting's time went into popping them); only the patches near the top are kept in order,
+//! the rest rebuilt in when the top reaches them (`KeyHeap`'s hot and cold patches).
 
 use super::estimate::{self, Books, Estimator};
 use super::key_heap::KeyHeap;
 use super::{scalar, EnergyBalance, SolveStats, TracePoint};
 use crate::mesh::Mesh;
 use crate::scene::Material;
+
+/// A patch's unshot radiosity (scalar), its key in the max-ΔB queue.
+#[inline]
+fn key_b(p: &PatchState) -> f64 {
+    scalar(&p.unshot) * p.inv_area as f64
+}
+
+/// `key` if it is at least `threshold`, else 0 (not in the max-ΔB queue).
+#[inline]
+fn above(key: f64, threshold: f64) -> f64 {
+    if key >= threshold {
+        key
+    } else {
+        0.0
+    }
+}
 
 /// a += b, per channel.
 #[inline]
@@ -176,7 +193,7 @@ impl State {
     }
     #[inline]
     fn key_b(&self, i: usize) -> f64 {
-        scalar(&self.patches[i].unshot) * self.patches[i].inv_area as f64
+        key_b(&self.patches[i])
     }
 
     /// Area-weighted mean radiosity (scalar), W/m².
@@ -218,11 +235,21 @@ impl State {
 
     /// Max unshot radiosity (scalar) over the patches above the stop threshold, from the heap
     /// (0 when none is above it).
+    ///
+    /// A patch below the threshold now may be left out even if it was above it when last
+    /// touched (the queue is rebuilt from the current threshold): whatever is below the
+    /// threshold satisfies Sec. 3's stop as 0 does, so the verdict is the same.
     pub fn max_unshot_b(&mut self) -> f64 {
+        let threshold = self.b_threshold();
         let patches = &self.patches;
         self.by_b
-            .peek(|i| scalar(&patches[i].unshot) * patches[i].inv_area as f64)
+            .peek(|i| above(key_b(&patches[i]), threshold))
             .map_or(0.0, |e| e.0)
+    }
+
+    /// The max-ΔB queue's pruning threshold, f·mean(B)·(1 − ρ_max) (see `finish_batch`).
+    fn b_threshold(&self) -> f64 {
+        self.stop_fraction * self.mean_b() * (1.0 - self.rho_max)
     }
 
     /// Is any unshot energy left?
@@ -441,7 +468,7 @@ impl State {
     /// 1/(1 − ρ_max)), so a patch below it now matters again only once it grows, and then it
     /// is pushed again.
     pub fn finish_batch(&mut self) {
-        let threshold = self.stop_fraction * self.mean_b() * (1.0 - self.rho_max);
+        let threshold = self.b_threshold();
         let list = std::mem::take(&mut self.touched_list);
         for &j in &list {
             let j = j as usize;
@@ -456,6 +483,15 @@ impl State {
         }
         self.touched_list = list;
         self.touched_list.clear();
+        self.trim_queues(threshold);
+    }
+
+    /// Rebuilds a queue grown past twice its hot patches (`KeyHeap::trim`), the max-ΔB queue
+    /// from the patches at or above `threshold` only.
+    fn trim_queues(&mut self, threshold: f64) {
+        let patches = &self.patches;
+        self.by_flux.trim(|i| scalar(&patches[i].unshot));
+        self.by_b.trim(|i| above(key_b(&patches[i]), threshold));
     }
 
     /// Radiosity per patch: B_j = E_j + kept_j / A_j.
@@ -551,7 +587,7 @@ impl State {
         // max-ΔB heap's pruning threshold left out, as the running solve does).
         self.by_flux = KeyHeap::with_patches(n);
         self.by_b = KeyHeap::with_patches(n);
-        let threshold = self.stop_fraction * self.mean_b() * (1.0 - self.rho_max);
+        let threshold = self.b_threshold();
         for j in 0..n {
             let (kf, kb) = (self.key_flux(j), self.key_b(j));
             self.by_flux.set(kf, j);
@@ -559,6 +595,7 @@ impl State {
                 self.by_b.set(kb, j);
             }
         }
+        self.trim_queues(threshold);
         Ok(())
     }
 

@@ -12,7 +12,7 @@
 //! shooters are taken from the top of the queue in *waves* (about [`wave_rays`] rays, or
 //! [`CUBE_WAVE`] hemi-cubes), cast in parallel against the books at the start of the wave (in
 //! the order of their patches, for the cache), and their hits applied in the queue's order.
-//! Picking a shooter costs O(log patches) (an indexed binary heap, `key_heap::KeyHeap`), never
+//! Picking a shooter costs O(log patches) (an indexed heap, `key_heap::KeyHeap`), not
 //! O(patches). Ray waves are pipelined: while one thread applies wave k's hits, the others
 //! cast wave k + 1, which was taken off the heap before wave k's deposits reached it; its
 //! shooters are then at most one wave out of date, the books stay exact and the order stays

@@ -3,6 +3,15 @@
 //! picking a shooter costs O(log patches), never a scan, and no stale entry is popped (an
 //! earlier design pushed a new entry per change: on a million patches a sixth of the
 //! shooting's time went into popping them).
+//!
+//! **Hot and cold.** Only the patches whose key is at least a *floor* are kept in order (the
+//! hot ones, about [`hot_size`] of them); a change to a key below it costs one comparison.
+//! The top of the heap is then the largest key of all as long as it is at or above the floor;
+//! when it falls below (the hot patches shot), the heap is rebuilt from every patch's current
+//! key with a new floor, the [`hot_size`]-th largest key — O(patches), a scan in memory order,
+//! once per [`hot_size`] shooters or so. So the top, and the shooters' order, are exactly what
+//! one heap of every patch gives; a wave's deposits, most of them on patches far from being
+//! shot, no longer sift through a heap of a million (docs/results/hot-queues.md).
 
 use std::cmp::Ordering;
 
@@ -26,12 +35,17 @@ impl Ord for Entry {
 /// `pos` records, so a key that changes is moved in place (O(log patches)) rather than
 /// pushed again. Ties go to the lower patch number ([`Entry`]'s order). A patch whose key
 /// changed without [`Self::set`] (a shooter, zeroed when taken) is put right when it comes
-/// to the top ([`Self::peek`]).
-#[derive(Default)]
+/// to the top ([`Self::peek`]). Only keys at or above `floor` are kept in order (module
+/// notes): below it an entry may be missing or stale, which [`Self::peek`] allows for.
 pub(super) struct KeyHeap {
     heap: Vec<Entry>,
     /// Position of each patch in `heap`; [`ABSENT`] when it is not in it.
     pos: Vec<u32>,
+    /// Every patch whose current key is at least this (and positive) is in `heap` with that
+    /// key; 0 until the heap first grows past twice `hot` ([`Self::trim`]).
+    floor: f64,
+    /// How many patches a rebuild keeps hot.
+    hot: usize,
 }
 
 /// [`KeyHeap::pos`] of a patch not in the heap.
@@ -42,20 +56,41 @@ const ABSENT: u32 = u32::MAX;
 /// arity (keys and ties make a total order), so the solver's shots are the same.
 const ARITY: usize = 4;
 
+/// How many of `n` patches a rebuild keeps hot: a sixteenth, at least 4,096.
+pub(super) fn hot_size(n: usize) -> usize {
+    (n / 16).max(4096)
+}
+
 impl KeyHeap {
     pub(super) fn with_patches(n: usize) -> KeyHeap {
+        KeyHeap::with_hot(n, hot_size(n))
+    }
+
+    /// A heap of `n` patches that keeps `hot` of them in order.
+    pub(super) fn with_hot(n: usize, hot: usize) -> KeyHeap {
         KeyHeap {
             heap: Vec::new(),
             pos: vec![ABSENT; n],
+            floor: 0.0,
+            hot: hot.max(1),
         }
     }
 
-    /// Patch `i`'s key is now `key`: inserted, moved, or (key ≤ 0) taken out.
+    /// Patch `i`'s key is now `key`: inserted, moved, or (key ≤ 0) taken out; below the
+    /// floor, left as it is (cold).
     pub(super) fn set(&mut self, key: f64, i: usize) {
         if key <= 0.0 {
             self.remove(i);
             return;
         }
+        if key < self.floor {
+            return;
+        }
+        self.place(key, i);
+    }
+
+    /// Patch `i` (key > 0) put in at `key`, or moved there.
+    fn place(&mut self, key: f64, i: usize) {
         let e = Entry(key, i as u32);
         match self.pos[i] {
             ABSENT => {
@@ -72,6 +107,42 @@ impl KeyHeap {
                     self.down(p);
                 }
             }
+        }
+    }
+
+    /// Rebuilds the heap when it holds more than twice its hot patches (after a batch of
+    /// [`Self::set`]s), `key_of` giving every patch's current key.
+    pub(super) fn trim(&mut self, key_of: impl Fn(usize) -> f64) {
+        if self.heap.len() > 2 * self.hot {
+            self.rebuild(&key_of);
+        }
+    }
+
+    /// The heap of the patches whose key is at least the new floor: the `hot`-th largest
+    /// positive key (0 when there are no more positive keys than `hot`).
+    fn rebuild(&mut self, key_of: &impl Fn(usize) -> f64) {
+        for e in &self.heap {
+            self.pos[e.1 as usize] = ABSENT;
+        }
+        self.heap.clear();
+        let n = self.pos.len();
+        let mut keys: Vec<f64> = (0..n).map(key_of).filter(|&k| k > 0.0).collect();
+        self.floor = if keys.len() <= self.hot {
+            0.0
+        } else {
+            let at = keys.len() - self.hot;
+            *keys.select_nth_unstable_by(at, f64::total_cmp).1
+        };
+        for i in 0..n {
+            let k = key_of(i);
+            if k > 0.0 && k >= self.floor {
+                self.pos[i] = self.heap.len() as u32;
+                self.heap.push(Entry(k, i as u32));
+            }
+        }
+        // Floyd's heap construction: every inner node sifted down, the last first.
+        for k in (0..self.heap.len().div_ceil(ARITY)).rev() {
+            self.down(k);
         }
     }
 
@@ -95,16 +166,33 @@ impl KeyHeap {
         }
     }
 
-    /// The top entry, its key checked against `key_of` (and put right first where stale).
+    /// The top entry, its key checked against `key_of` (and put right first where stale):
+    /// the largest current key of all patches. A top below the floor, or an empty heap above
+    /// a floor, means a cold patch may be larger: the heap is rebuilt first.
     pub(super) fn peek(&mut self, key_of: impl Fn(usize) -> f64) -> Option<Entry> {
-        while let Some(&top) = self.heap.first() {
+        loop {
+            let Some(&top) = self.heap.first() else {
+                if self.floor > 0.0 {
+                    self.rebuild(&key_of);
+                    continue;
+                }
+                return None;
+            };
             let key = key_of(top.1 as usize);
-            if key == top.0 {
-                return Some(top);
+            if key != top.0 {
+                if key > 0.0 {
+                    self.place(key, top.1 as usize);
+                } else {
+                    self.remove(top.1 as usize);
+                }
+                continue;
             }
-            self.set(key, top.1 as usize);
+            if key < self.floor {
+                self.rebuild(&key_of);
+                continue;
+            }
+            return Some(top);
         }
-        None
     }
 
     /// Takes the top entry out.
@@ -166,13 +254,26 @@ mod tests {
 
     /// The indexed heap gives the same top as a scan over the current keys, whatever mix of
     /// inserts, moves up and down, removals and pops, ties to the lower patch number; a key
-    /// lowered without `set` (as a shooter's is, zeroed when taken) is put right at the top.
+    /// lowered without `set` (as a shooter's is, zeroed when taken) is put right at the top;
+    /// with few patches hot, as with all of them.
     #[test]
     fn key_heap_top_is_the_largest_current_key() {
         let n = 200;
         let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        // Every patch hot (never rebuilt), and 8 of 200 hot (rebuilt again and again).
+        for hot in [n, 8] {
+            let mut heap = KeyHeap::with_hot(n, hot);
+            let floor = top_stays_the_largest(&mut heap, &mut rng);
+            assert_eq!(floor > 0.0, hot < n, "{hot}");
+        }
+    }
+
+    /// Random sets, removals, keys halved or zeroed without `set`, pops and trims: after
+    /// each, `peek` gives the largest current key. Returns the highest floor there was.
+    fn top_stays_the_largest(heap: &mut KeyHeap, rng: &mut rand_pcg::Pcg64) -> f64 {
+        let mut floor = 0.0f64;
+        let n = heap.pos.len();
         let mut keys = vec![0.0f64; n];
-        let mut heap = KeyHeap::with_patches(n);
         for step in 0..20_000 {
             let i = rng.gen_range(0..n);
             match rng.gen_range(0..6) {
@@ -180,7 +281,12 @@ mod tests {
                 0 | 1 => {
                     keys[i] = rng.gen_range(0..8) as f64;
                     heap.set(keys[i], i);
-                    assert_eq!(heap.pos[i] != ABSENT, keys[i] > 0.0, "step {step}");
+                    if keys[i] >= heap.floor {
+                        assert_eq!(heap.pos[i] != ABSENT, keys[i] > 0.0, "step {step}");
+                    }
+                    if step % 7 == 0 {
+                        heap.trim(|j| keys[j]);
+                    }
                 }
                 2 => {
                     keys[i] = 0.0;
@@ -201,6 +307,8 @@ mod tests {
                 .max();
             let got = heap.peek(|j| keys[j]);
             assert_eq!(got.map(|e| e.1), want.map(|e| e.1), "step {step}");
+            floor = floor.max(heap.floor);
         }
+        floor
     }
 }
