@@ -114,9 +114,11 @@ fn resumed_runs_equal_uninterrupted_ones() {
 #[test]
 fn an_interrupt_stops_at_a_safe_point_with_a_checkpoint() {
     let (s, m) = office();
+    // No final gather: the shooting runs to Sec. 3's stop, well past the third safe point.
     let base = SolveSettings {
         method: MethodKind::AdaptiveRays,
         tolerance: 0.03,
+        final_gather: false,
         ..SolveSettings::default()
     };
     let plain = run(&s, &m, &base);
