@@ -249,32 +249,30 @@ impl Emitters {
     /// Returns the nodes in tree order and their estimates, all positive.
     fn cut_for(&self, r: &Receiver, reached: Option<&[u32]>) -> (Vec<u32>, Vec<f64>) {
         use std::collections::BinaryHeap;
-        /// A node of the cut, ordered by its priority, then by index (a deterministic split);
-        /// and its estimate.
-        #[derive(PartialEq)]
-        struct Open(f64, u32, f64);
-        impl Eq for Open {}
-        impl PartialOrd for Open {
-            fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
-                Some(self.cmp(o))
-            }
-        }
-        impl Ord for Open {
-            fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-                self.0.total_cmp(&o.0).then(o.1.cmp(&self.1))
-            }
-        }
-        let mut open = BinaryHeap::new();
+        // An open node as (its priority's bits, u32::MAX − the node, its estimate's slot in
+        // `open_w`): a positive f64's bits order as the f64 does, so the largest priority
+        // comes first, ties to the lower node (a deterministic split); 16 bytes compared as
+        // integers (popping a heap of f64 triples was a fifth of the cuts' samples in a
+        // profile of the 1 M-patch building's gather).
+        let mut open: BinaryHeap<(u64, u32, u32)> = BinaryHeap::new();
+        let mut open_w: Vec<f64> = Vec::new();
         // (the node's first place in the order, the node, its estimate): sorted by the first.
         let mut done: Vec<(u32, u32, f64)> = Vec::new();
         let start = |n: u32| self.nodes[n as usize].start as u32;
         // Files node n where it belongs; whether it can light r (then it holds a place).
-        let file = |n: u32, open: &mut BinaryHeap<Open>, done: &mut Vec<(u32, u32, f64)>| {
+        let file = |n: u32,
+                    open: &mut BinaryHeap<(u64, u32, u32)>,
+                    open_w: &mut Vec<f64>,
+                    done: &mut Vec<(u32, u32, f64)>| {
             let node = &self.nodes[n as usize];
             let w = contribution(node, r);
             if w > 0.0 {
                 match node.children {
-                    Some(_) => open.push(Open(w * sight::split_priority(node, reached), n, w)),
+                    Some(_) => {
+                        let priority = w * sight::split_priority(node, reached);
+                        open.push((priority.to_bits(), u32::MAX - n, open_w.len() as u32));
+                        open_w.push(w);
+                    }
                     None => done.push((node.start as u32, n, w)),
                 }
             }
@@ -282,21 +280,25 @@ impl Emitters {
         };
         let mut held = 0usize;
         for &n in &self.roots {
-            held += usize::from(file(n, &mut open, &mut done));
+            held += usize::from(file(n, &mut open, &mut open_w, &mut done));
         }
         while held < CLUSTERS {
-            let Some(Open(_, n, _)) = open.pop() else {
+            let Some((_, rev, _)) = open.pop() else {
                 break;
             };
+            let n = u32::MAX - rev;
             let [a, b] = self.nodes[n as usize]
                 .children
                 .expect("only inner nodes are open");
             held -= 1;
-            held += usize::from(file(a, &mut open, &mut done));
-            held += usize::from(file(b, &mut open, &mut done));
+            held += usize::from(file(a, &mut open, &mut open_w, &mut done));
+            held += usize::from(file(b, &mut open, &mut open_w, &mut done));
         }
         // The cut is full: the nodes still open join it as they are (their order is the sort's).
-        done.extend(open.into_iter().map(|Open(_, n, w)| (start(n), n, w)));
+        done.extend((open.into_iter()).map(|(_, rev, slot)| {
+            let n = u32::MAX - rev;
+            (start(n), n, open_w[slot as usize])
+        }));
         // Nodes of a cut cover disjoint stretches of the order: their first places differ.
         done.sort_unstable_by_key(|&(s, _, _)| s);
         done.into_iter().map(|(_, n, w)| (n, w)).unzip()

@@ -124,22 +124,26 @@ impl KeyHeap {
         for e in &self.heap {
             self.pos[e.1 as usize] = ABSENT;
         }
-        self.heap.clear();
-        let n = self.pos.len();
-        let mut keys: Vec<f64> = (0..n).map(key_of).filter(|&k| k > 0.0).collect();
-        self.floor = if keys.len() <= self.hot {
+        // One pass over the keys: every patch with a positive key, then the hot ones kept.
+        let mut heap = std::mem::take(&mut self.heap);
+        heap.clear();
+        heap.extend((0..self.pos.len()).filter_map(|i| {
+            let k = key_of(i);
+            (k > 0.0).then_some(Entry(k, i as u32))
+        }));
+        self.floor = if heap.len() <= self.hot {
             0.0
         } else {
-            let at = keys.len() - self.hot;
-            *keys.select_nth_unstable_by(at, f64::total_cmp).1
+            let at = heap.len() - self.hot;
+            heap.select_nth_unstable_by(at, |a, b| a.0.total_cmp(&b.0));
+            let floor = heap[at].0;
+            heap.retain(|e| e.0 >= floor);
+            floor
         };
-        for i in 0..n {
-            let k = key_of(i);
-            if k > 0.0 && k >= self.floor {
-                self.pos[i] = self.heap.len() as u32;
-                self.heap.push(Entry(k, i as u32));
-            }
+        for (k, e) in heap.iter().enumerate() {
+            self.pos[e.1 as usize] = k as u32;
         }
+        self.heap = heap;
         // Floyd's heap construction: every inner node sifted down, the last first.
         for k in (0..self.heap.len().div_ceil(ARITY)).rev() {
             self.down(k);
