@@ -3,9 +3,9 @@
 //! ([`super::ray_shots`]) and the hemi-cube shots ([`super::cube_shots`]), so every method
 //! keeps the same books and stops by the same criterion (Sec. 3, [`super::stopping`]).
 //!
-//! Picking a shooter costs O(log patches): indexed 4-ary heaps ([`super::key_heap`]), one by
-//! unshot flux (who shoots next) and one by unshot radiosity (the stopping criterion), not a
-//! scan per shot. A patch is in each at most once and moves when its key changes (an earlier design
+//! Picking a shooter costs O(log patches): indexed 4-ary heaps (`key_heap`), one by unshot
+//! flux (who shoots next) and one by unshot radiosity (the stopping criterion), not a scan per
+//! shot. A patch is in each at most once and moves when its key changes (an earlier design
 //! pushed a new entry per change and skipped stale ones: on a million patches a sixth of the
 //! shooting's time went into popping them); only the patches near the top are kept in order,
 //! the rest rebuilt in when the top reaches them (`KeyHeap`'s hot and cold patches).
