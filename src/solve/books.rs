@@ -486,7 +486,7 @@ impl State {
         self.trim_queues(threshold);
     }
 
-    /// Rebuilds a queue grown past twice its hot patches (`KeyHeap::trim`), the max-ΔB queue
+    /// Rebuilds a queue grown past twice its last rebuild (`KeyHeap::trim`), the max-ΔB queue
     /// from the patches at or above `threshold` only.
     fn trim_queues(&mut self, threshold: f64) {
         let patches = &self.patches;

@@ -46,6 +46,10 @@ pub(super) struct KeyHeap {
     floor: f64,
     /// How many patches a rebuild keeps hot.
     hot: usize,
+    /// [`Self::trim`] rebuilds past this many entries: twice what the last rebuild left
+    /// (at least twice `hot`; more where keys tie the floor), so a heap of ties is not
+    /// rebuilt after every batch.
+    limit: usize,
 }
 
 /// [`KeyHeap::pos`] of a patch not in the heap.
@@ -73,6 +77,7 @@ impl KeyHeap {
             pos: vec![ABSENT; n],
             floor: 0.0,
             hot: hot.max(1),
+            limit: 2 * hot.max(1),
         }
     }
 
@@ -110,10 +115,10 @@ impl KeyHeap {
         }
     }
 
-    /// Rebuilds the heap when it holds more than twice its hot patches (after a batch of
-    /// [`Self::set`]s), `key_of` giving every patch's current key.
+    /// Rebuilds the heap when it holds more than twice what the last rebuild left (after a
+    /// batch of [`Self::set`]s), `key_of` giving every patch's current key.
     pub(super) fn trim(&mut self, key_of: impl Fn(usize) -> f64) {
-        if self.heap.len() > 2 * self.hot {
+        if self.heap.len() > self.limit {
             self.rebuild(&key_of);
         }
     }
@@ -144,6 +149,7 @@ impl KeyHeap {
             self.pos[e.1 as usize] = k as u32;
         }
         self.heap = heap;
+        self.limit = 2 * self.heap.len().max(self.hot);
         // Floyd's heap construction: every inner node sifted down, the last first.
         for k in (0..self.heap.len().div_ceil(ARITY)).rev() {
             self.down(k);
