@@ -234,6 +234,20 @@ impl Elements {
         }
     }
 
+    /// Whether these elements are the patches of `mesh` with radiosity `b` themselves (what
+    /// [`Elements::of_patches`] makes): one element per patch, in patch order, with the
+    /// patch's material, centre, normal, area and radiosity — every column of its row in
+    /// `elements.csv` but the last is then its patch's in `patches.csv`.
+    pub fn are_the_patches(&self, mesh: &Mesh, b: &[[f64; 3]]) -> bool {
+        let same = |(e, p): (&crate::mesh::Patch, &crate::mesh::Patch)| {
+            (e.material, e.area, e.centre, e.normal) == (p.material, p.area, p.centre, p.normal)
+        };
+        self.mesh.patches.len() == mesh.patches.len()
+            && self.b == b
+            && (self.patch.iter().enumerate()).all(|(k, &p)| p as usize == k)
+            && (self.mesh.patches.iter().zip(&mesh.patches)).all(same)
+    }
+
     /// The radiosity the elements interpolate at parameters `uv` of root `root` of patch
     /// `patch` (bilinear in a quad element, barycentric in a triangle; what Gouraud shading
     /// shows up to the triangulation of quads), when an element there is known.

@@ -113,6 +113,34 @@ fn write_rows(
     Ok(())
 }
 
+/// The element table of elements that are the patches themselves (the elements off or
+/// skipped, `crate::elements::Elements::are_the_patches`), made from the patch table `r` as
+/// written: each row as it stands there, then its own id as [`PATCH_COLUMN`] — the bytes
+/// [`write_elements`] would write, each number formatted once (on a million patches the
+/// formatting is most of the time the two tables take).
+pub fn elements_of_patch_table(r: &mut impl BufRead, w: &mut dyn Write) -> io::Result<()> {
+    let mut line = Vec::with_capacity(256);
+    let mut id = 0u64;
+    let mut header = true;
+    loop {
+        line.clear();
+        if r.read_until(b'\n', &mut line)? == 0 {
+            return Ok(());
+        }
+        let row = line.strip_suffix(b"\n").ok_or_else(|| {
+            io::Error::new(io::ErrorKind::InvalidData, "the patch table ends mid-row")
+        })?;
+        w.write_all(row)?;
+        if header {
+            header = false;
+            writeln!(w, ",{PATCH_COLUMN}")?;
+        } else {
+            writeln!(w, ",{id}")?;
+            id += 1;
+        }
+    }
+}
+
 /// Rows of a table formatted together by one thread ([`write_rows`]) ...
 const ROWS_PER_CHUNK: usize = 16_384;
 /// ... and chunks formatted before they are written (about 50 MB of text).

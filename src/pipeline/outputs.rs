@@ -104,18 +104,25 @@ pub fn write(
     write_atomic(&csv, |w| {
         patches::write(w, m, &scene.materials, &sol.b, sky_lux)
     })?;
-    wrote(csv);
+    wrote(csv.clone());
     let el_csv = job.out.join("elements.csv");
-    write_atomic(&el_csv, |w| {
-        patches::write_elements(
-            w,
-            &elements.mesh,
-            &scene.materials,
-            &elements.b,
-            sky_lux,
-            &elements.patch,
-        )
-    })?;
+    if elements.are_the_patches(m, &sol.b) {
+        write_atomic(&el_csv, |w| {
+            let mut table = std::io::BufReader::new(std::fs::File::open(&csv)?);
+            patches::elements_of_patch_table(&mut table, w)
+        })?;
+    } else {
+        write_atomic(&el_csv, |w| {
+            patches::write_elements(
+                w,
+                &elements.mesh,
+                &scene.materials,
+                &elements.b,
+                sky_lux,
+                &elements.patch,
+            )
+        })?;
+    }
     wrote(el_csv);
     if let Some(g) = &results.measured {
         let grid_csv = job.out.join("grid.csv");

@@ -386,3 +386,24 @@ fn solve_reports_in_one_line_or_json_and_refuses_a_bad_save_path() {
         &["--save", "folder"],
     );
 }
+
+/// With the elements off, `elements.csv` is `patches.csv` with each row's own id as its patch
+/// column: every other cell the same text, row for row.
+#[test]
+fn elements_off_give_the_patch_table_with_each_rows_id() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    ok(&["solve", "--out", s(&out), "--elements", "off", "--quiet"]);
+    let patches = std::fs::read_to_string(out.join("patches.csv")).unwrap();
+    let elements = std::fs::read_to_string(out.join("elements.csv")).unwrap();
+    assert!(patches.lines().count() > 100);
+    assert_eq!(patches.lines().count(), elements.lines().count());
+    for (k, (p, e)) in patches.lines().zip(elements.lines()).enumerate() {
+        let want = match k {
+            0 => format!("{p},patch"),
+            _ => format!("{p},{}", k - 1),
+        };
+        assert_eq!(e, want, "row {k}");
+    }
+    assert!(elements.ends_with('\n'));
+}
