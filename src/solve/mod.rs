@@ -37,6 +37,7 @@ pub mod cube_shots;
 pub mod driver;
 pub mod estimate;
 pub mod final_gather;
+mod gather_budget;
 mod key_heap;
 pub mod lights;
 pub mod luminaire_shots;

@@ -492,7 +492,9 @@ impl<'a, I: Intersector> Passes<'a, I> {
         let elapsed = self.at.start.elapsed().as_secs_f64();
         let cast = self.trace.last().map_or(so_far, |t| t.rays as f64);
         let want = plan.rays.ceil() as usize;
-        if super::driver::gather_rays_fitting(self.at.cfg, want, 1, cast, elapsed) != Some(want) {
+        if super::gather_budget::gather_rays_fitting(self.at.cfg, want, 1, cast, elapsed)
+            != Some(want)
+        {
             self.out.stats.stop_reason = Some(StopReason::MaxTime);
             return false;
         }
@@ -586,7 +588,7 @@ impl<'a, I: Intersector> Passes<'a, I> {
             let elapsed = self.at.start.elapsed().as_secs_f64();
             let cast = so_far + samples(sol);
             let np = self.at.mesh.patches.len();
-            let r = super::driver::gather_rays_fitting(cfg, wanted, np, cast, elapsed)?;
+            let r = super::gather_budget::gather_rays_fitting(cfg, wanted, np, cast, elapsed)?;
             scale = scale * r as f64 / wanted.max(1) as f64;
         }
         Some(scale)
