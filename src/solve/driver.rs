@@ -16,7 +16,10 @@
 //! O(patches). Ray waves are pipelined: while one thread applies wave k's hits, the others
 //! cast wave k + 1, which was taken off the heap before wave k's deposits reached it; its
 //! shooters are then at most one wave out of date, the books stay exact and the order stays
-//! fixed.
+//! fixed. The applying thread then makes the next step's head — the stop rule, a trace point,
+//! wave k + 2 taken off the heap — while wave k + 1 is still being cast, on the books a step
+//! would see after it (late in a solve, taking tens of thousands of one-ray shooters off the
+//! heap was a sixth of the shooting's time with the other core idle).
 //!
 //! **Reproducible.** Every random number comes from (seed, shot, chunk); a wave's composition
 //! depends on the books and the settings only; the hybrid's switch on counted work (by
@@ -191,6 +194,51 @@ struct Pending {
     hits: Vec<Hits>,
 }
 
+/// What a step of the shooting does, once its head ([`Driver::head`]) is made.
+enum Step {
+    /// Stop, for this reason (its last trace point recorded).
+    Stop(StopReason),
+    /// Land the wave in flight, then look again.
+    Land,
+    /// Shoot these ray shots (none: land the wave in flight first).
+    Rays(Vec<RayShot>),
+    /// Shoot a wave of hemi-cubes.
+    Cubes,
+}
+
+/// A ray wave cast but not yet applied, as the stop rule counts it: its rays (every ray has a
+/// hit code, a covered one too) and its flux (scalar W).
+#[derive(Clone, Copy)]
+struct Flight {
+    rays: u64,
+    flux: f64,
+    /// Whether there is such a wave.
+    landing: bool,
+}
+
+impl Flight {
+    /// The wave in flight, `pending`.
+    fn of_pending(pending: Option<&Pending>) -> Flight {
+        pending.map_or(
+            Flight {
+                rays: 0,
+                flux: 0.0,
+                landing: false,
+            },
+            |p| Flight::of(&p.wave, &p.tasks),
+        )
+    }
+
+    /// The wave `wave` of tasks `tasks`.
+    fn of(wave: &[RayShot], tasks: &[Task]) -> Flight {
+        Flight {
+            rays: tasks.iter().map(|t| t.count as u64).sum(),
+            flux: wave.iter().map(|s| scalar(&s.phi)).sum::<f64>(),
+            landing: true,
+        }
+    }
+}
+
 /// One shooting solve in progress.
 struct Driver<'a, I> {
     mesh: &'a Mesh,
@@ -213,6 +261,8 @@ struct Driver<'a, I> {
     switch: SwitchPolicy,
     stats: SolveStats,
     pending: Option<Pending>,
+    /// The next step's head, made while the last wave was cast ([`Driver::ray_wave`]).
+    ahead: Option<Step>,
     /// Seconds the run resumed from had already taken.
     time_offset: f64,
     next_trace: f64,
@@ -334,6 +384,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
                 ..SolveStats::default()
             },
             pending: None,
+            ahead: None,
             time_offset: 0.0,
             next_trace: 0.0,
             next_trace_shots: 0,
@@ -444,32 +495,62 @@ impl<'a, I: Intersector> Driver<'a, I> {
         start: Instant,
         on_trace: &mut impl FnMut(&TracePoint),
     ) -> Result<StopReason, SolveError> {
+        let mut reported = self.stats.trace.len();
         loop {
             let elapsed = self.time_offset + start.elapsed().as_secs_f64();
             self.safe_point(elapsed)?;
-            let (progress, flying) = self.progress(elapsed);
-            let cfg = self.cfg;
-            let st = &mut self.st;
-            if let Some(r) = stopping::verdict(cfg, &progress, || st.has_unshot()) {
-                // Deposits still in flight may change the verdict: apply them and look again.
-                if self.land_pending() {
-                    continue;
+            let step = match self.ahead.take() {
+                Some(step) => step,
+                None => {
+                    let flight = Flight::of_pending(self.pending.as_ref());
+                    self.head(elapsed, flight)
                 }
-                self.record(elapsed, progress.max_unshot_b, 0.0, on_trace);
-                return Ok(r);
+            };
+            for p in &self.stats.trace[reported..] {
+                on_trace(p);
             }
-            // Trace points at geometric steps of time and of shots (even spacing on the log-log
-            // plots of error against time). They read the books, never change them.
-            if elapsed >= self.next_trace || self.stats.shots >= self.next_trace_shots {
-                self.record(elapsed, progress.max_unshot_b, flying, on_trace);
-                self.next_trace = (elapsed * 1.25).max(elapsed + 0.002);
-                self.next_trace_shots = (self.stats.shots as f64 * 1.25) as u64 + 8;
+            reported = self.stats.trace.len();
+            match step {
+                Step::Stop(r) => return Ok(r),
+                // Nothing to shoot until the wave in flight lands, or deposits still in flight
+                // may change the stop rule's verdict: apply them and look again.
+                Step::Land => {
+                    self.land_pending();
+                }
+                Step::Rays(wave) if wave.is_empty() => {
+                    self.land_pending();
+                }
+                Step::Rays(wave) => self.ray_wave(wave, start),
+                Step::Cubes => self.cube_wave(),
             }
-            if self.cubes.is_some() {
-                self.cube_wave();
-            } else {
-                self.ray_wave(progress.samples);
+        }
+    }
+
+    /// What a step does before it shoots, on the books as they stand with `flight` still to
+    /// land: Sec. 3's stop rule, a trace point when one is due, and the next wave's shooters
+    /// taken off the queue.
+    fn head(&mut self, elapsed: f64, flight: Flight) -> Step {
+        let progress = self.progress(elapsed, flight);
+        let cfg = self.cfg;
+        let st = &mut self.st;
+        if let Some(r) = stopping::verdict(cfg, &progress, || st.has_unshot()) {
+            if flight.landing {
+                return Step::Land;
             }
+            self.record(elapsed, progress.max_unshot_b, 0.0);
+            return Step::Stop(r);
+        }
+        // Trace points at geometric steps of time and of shots (even spacing on the log-log
+        // plots of error against time). They read the books, never change them.
+        if elapsed >= self.next_trace || self.stats.shots >= self.next_trace_shots {
+            self.record(elapsed, progress.max_unshot_b, flight.flux);
+            self.next_trace = (elapsed * 1.25).max(elapsed + 0.002);
+            self.next_trace_shots = (self.stats.shots as f64 * 1.25) as u64 + 8;
+        }
+        if self.cubes.is_some() {
+            Step::Cubes
+        } else {
+            Step::Rays(self.take_ray_wave(progress.samples))
         }
     }
 
@@ -510,45 +591,25 @@ impl<'a, I: Intersector> Driver<'a, I> {
         Ok(())
     }
 
-    /// What the stop rule looks at, and the flux of the wave in flight (scalar W).
-    fn progress(&mut self, elapsed: f64) -> (Progress, f64) {
-        let (in_flight, flying) = self.pending.as_ref().map_or((0, 0.0), |p| {
-            (
-                p.hits.iter().map(|h| h.codes.len()).sum::<usize>() as u64,
-                p.wave.iter().map(|s| scalar(&s.phi)).sum::<f64>(),
-            )
-        });
-        let progress = Progress {
+    /// What the stop rule looks at, with `flight` cast but not applied.
+    fn progress(&mut self, elapsed: f64, flight: Flight) -> Progress {
+        Progress {
             interrupted: self.interrupt_now,
             max_unshot_b: self.st.max_unshot_b(),
-            amplification: self.st.amplification(flying),
+            amplification: self.st.amplification(flight.flux),
             mean_b: self.st.mean_b(),
             elapsed,
-            samples: self.st.rays + self.st.cells + in_flight,
-            unshot_share: self.st.unshot_share(flying),
-        };
-        (progress, flying)
+            samples: self.st.rays + self.st.cells + flight.rays,
+            unshot_share: self.st.unshot_share(flight.flux),
+        }
     }
 
-    /// Adds a trace point (the books are only read).
-    fn record(
-        &mut self,
-        elapsed: f64,
-        max_b: f64,
-        flying: f64,
-        on_trace: &mut impl FnMut(&TracePoint),
-    ) {
+    /// Adds a trace point (the books are only read); `run` reports it.
+    fn record(&mut self, elapsed: f64, max_b: f64, flying: f64) {
         let est = self.scalars.estimator(self.energy_per_ray);
         let reference = self.hooks.reference.as_deref().map(Vec::as_slice);
-        self.st.record(
-            &mut self.stats,
-            elapsed,
-            max_b,
-            &est,
-            reference,
-            flying,
-            on_trace,
-        );
+        let (stats, st) = (&mut self.stats, &self.st);
+        st.record(stats, elapsed, max_b, &est, reference, flying, &mut |_| {});
     }
 
     /// A wave of hemi-cube shots. For the hybrid, each shot first asks the switch policy
@@ -631,22 +692,32 @@ impl<'a, I: Intersector> Driver<'a, I> {
         wave
     }
 
-    /// A wave of ray shots, cast in parallel while the previous wave is applied.
-    fn ray_wave(&mut self, samples: u64) {
-        let wave = self.take_ray_wave(samples);
-        if wave.is_empty() {
-            // Nothing to shoot until the wave in flight lands.
-            self.land_pending();
-            return;
-        }
-        let caster = self.caster.as_ref().expect("checked in Driver::new");
+    /// A wave of ray shots (`wave`, not empty), cast in parallel while the previous wave is
+    /// applied; the thread that applies it then makes the next step's head (`Driver::head`:
+    /// the stop rule, a trace point, the next wave taken off the queue) while the others cast,
+    /// on the same books a step after this one would see, unless a safe point comes first (it
+    /// lands this wave before the next head).
+    fn ray_wave(&mut self, wave: Vec<RayShot>, start: Instant) {
+        let caster = self.caster.take().expect("checked in Driver::new");
         let tasks = tasks_of(&wave);
-        let cast = || cast_in_patch_order(caster, &wave, &tasks);
-        let st = &mut self.st;
+        let flight = Flight::of(&wave, &tasks);
+        let ahead = !(self.stats.waves + 1).is_multiple_of(SYNC_WAVES);
+        let cast = || cast_in_patch_order(&caster, &wave, &tasks);
         let hits = match self.pending.take() {
-            Some(p) => rayon::join(|| apply_rays(st, &p.wave, &p.tasks, &p.hits), cast).1,
+            Some(p) => {
+                let me = &mut *self;
+                let apply_then_head = || {
+                    apply_rays(&mut me.st, &p.wave, &p.tasks, &p.hits);
+                    if ahead {
+                        let elapsed = me.time_offset + start.elapsed().as_secs_f64();
+                        me.ahead = Some(me.head(elapsed, flight));
+                    }
+                };
+                rayon::join(apply_then_head, cast).1
+            }
             None => cast(),
         };
+        self.caster = Some(caster);
         self.pending = Some(Pending { wave, tasks, hits });
         self.stats.waves += 1;
     }
