@@ -240,9 +240,19 @@ pub fn patch_size(scene: &Scene, opts: &MeshOptions) -> f32 {
 /// where lights hang close to surfaces): the same pieces and divisions, counted, not made.
 /// Cheap: no patch is made, no vertex welded.
 pub fn rough_patch_count(scene: &Scene, opts: &MeshOptions) -> f64 {
+    rough_count(scene, opts, true)
+}
+
+/// [`rough_patch_count`] of the surface patches alone (no back twins).
+pub fn rough_surface_patch_count(scene: &Scene, opts: &MeshOptions) -> f64 {
+    rough_count(scene, opts, false)
+}
+
+/// The patches [`build`] makes before the cuts near lights, back twins counted or not.
+fn rough_count(scene: &Scene, opts: &MeshOptions, twins: bool) -> f64 {
     let size = patch_size(scene, opts);
     let per_polygon = |p: &crate::scene::Polygon| {
-        let sides = if back_material(scene, p, opts).is_some() {
+        let sides = if twins && back_material(scene, p, opts).is_some() {
             2.0
         } else {
             1.0

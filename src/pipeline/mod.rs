@@ -7,7 +7,7 @@
 //! | load      | [`stages::load`]             | the [`Scene`](crate::scene::Scene)   |
 //! | mesh      | [`stages::mesh`]             | the [`Model`] (scene and patches)    |
 //! | intersect | [`stages::intersect`]        | the intersector, if the method casts rays |
-//! | sides     | [`stages::sides`], [`stages::lit_backs`] | the hidden sides and the back patches of faces lit from behind, kept in the mesh |
+//! | sides     | [`stages::sides`], [`stages::lit_backs`] (or [`stages::lit_backs_ahead`], run beside the mesh, then [`stages::lit_backs_found`]) | the hidden sides and the back patches of faces lit from behind, kept in the mesh |
 //! | solve     | [`stages::solve`]            | the [`Solution`](crate::solve::Solution), read on as [`stages::Solved`] |
 //! | refine    | [`refine::refine`]           | the adaptive elements ([`refine::Refined`]) |
 //! | measure   | [`daylight::measure_grid`]   | the sensor grid ([`daylight::Measured`]) |
@@ -217,6 +217,30 @@ pub fn run_solve_with(
     result
 }
 
+/// The mesh, intersect and sides stages (docs/design.md §1), their times into `timings`;
+/// the clock of the sides stage is handed back running, for the faces lit from behind.
+fn mesh_and_sides(
+    job: &SolveJob,
+    scene: crate::scene::Scene,
+    progress: &Progress,
+    log: &mut impl FnMut(&str),
+    timings: &mut Timings,
+) -> Result<(Model, stages::SolveIntersector, Clock), Error> {
+    let clock = Clock::start();
+    let mut model = stages::mesh(job, scene, progress, log)?;
+    timings.mesh = clock.seconds();
+    timings.peak.mesh = report::peak_mib();
+
+    let clock = Clock::start();
+    let isect = stages::intersect(job, &model, progress, log)?;
+    timings.build = clock.seconds();
+    timings.peak.build = report::peak_mib();
+
+    let clock = Clock::start();
+    stages::sides(job, &mut model, isect.as_ref(), progress, log);
+    Ok((model, isect, clock))
+}
+
 /// The work of [`run_solve_with`] once the output folder is ready: the stages in order
 /// (docs/design.md §1). Every file written is recorded in `written` as soon as it exists.
 fn solve_into(
@@ -233,20 +257,30 @@ fn solve_into(
     timings.load = t0.elapsed().as_secs_f64();
     timings.peak.load = report::peak_mib();
 
-    let clock = Clock::start();
-    let mut model = stages::mesh(job, scene, progress, log)?;
-    timings.mesh = clock.seconds();
-    timings.peak.mesh = report::peak_mib();
-
-    let clock = Clock::start();
-    let isect = stages::intersect(job, &model, progress, log)?;
-    timings.build = clock.seconds();
-    timings.peak.build = report::peak_mib();
-
-    let clock = Clock::start();
-    stages::sides(job, &mut model, isect.as_ref(), progress, log);
-    let lit_backs = stages::lit_backs(job, &mut model, isect.as_ref(), progress, log)?;
-    timings.sides = clock.seconds();
+    // The mesh, its intersector and its hidden sides; beside them, on a thread of its own, the
+    // probe for faces lit from behind when the model is too large to be probed on its own mesh
+    // (`stages::lit_backs_ahead`: it cuts the scene coarser for itself). Its seconds are
+    // `lit_backs.seconds`; the sides stage counts any wait for it.
+    let (built, ahead) = std::thread::scope(|threads| {
+        let ahead = stages::probes_lit_backs(job).then(|| {
+            let scene = scene.clone();
+            threads.spawn(move || stages::lit_backs_ahead(job, &scene))
+        });
+        let built = mesh_and_sides(job, scene, progress, log, &mut timings);
+        (built, ahead.map(|probe| probe.join()))
+    });
+    let (mut model, isect, sides_clock) = built?;
+    let ahead = match ahead {
+        Some(joined) => joined.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?,
+        None => None,
+    };
+    let lit_backs = match (ahead, isect.as_ref()) {
+        (Some(found), Some((i, _))) => {
+            Some(stages::lit_backs_found(job, &mut model, i, found, log))
+        }
+        _ => stages::lit_backs(job, &mut model, isect.as_ref(), progress, log)?,
+    };
+    timings.sides = sides_clock.seconds();
     timings.peak.sides = report::peak_mib();
 
     let hooks = hooks::build(job, &model, log)?;

@@ -174,13 +174,6 @@ pub const LIT_BACKS_PROBE_PATCHES: usize = 100_000;
 /// [`LIT_BACKS_RAYS`] surface patches the probe's rays grow as the patches, one a patch.
 const LIT_BACKS_LOOSEST: f64 = 0.99;
 
-/// The tolerance of [`lit_backs`]'s first shooting: [`LIT_BACKS_TOLERANCE`], looser where
-/// the surface patches would make it cast more than [`LIT_BACKS_RAYS`] (up to
-/// [`LIT_BACKS_LOOSEST`]).
-fn lit_backs_tolerance(mesh: &crate::mesh::Mesh) -> f64 {
-    lit_backs_tolerance_for(surface_patches(mesh) as f64)
-}
-
 /// The patches of `mesh` that are not back twins.
 fn surface_patches(mesh: &crate::mesh::Mesh) -> usize {
     (0..mesh.patches.len())
@@ -188,7 +181,9 @@ fn surface_patches(mesh: &crate::mesh::Mesh) -> usize {
         .count()
 }
 
-/// [`lit_backs_tolerance`] for `n` surface patches.
+/// The tolerance of [`lit_backs`]'s first shooting for a model of `n` surface patches:
+/// [`LIT_BACKS_TOLERANCE`], looser where they would make it cast more than [`LIT_BACKS_RAYS`]
+/// (up to [`LIT_BACKS_LOOSEST`]).
 fn lit_backs_tolerance_for(n: f64) -> f64 {
     LIT_BACKS_TOLERANCE
         .max((n / LIT_BACKS_RAYS).sqrt())
@@ -196,7 +191,7 @@ fn lit_backs_tolerance_for(n: f64) -> f64 {
 }
 
 /// Lit backs: unless the mesh is two-sided or `--one-sided` is asked for, a first shooting
-/// (no final gather, no error target, the tolerance at least `lit_backs_tolerance`, until
+/// (no final gather, no error target, the tolerance at least `lit_backs_tolerance_for`, until
 /// [`LIT_BACKS_UNSHOT`] of the light is left) finds where light meets the back of a one-sided
 /// face — a model wound both ways, a room inside out — and the polygons lit so get back
 /// patches of their own (appended, so the intersector stays valid), as Radiance, whose
@@ -226,25 +221,97 @@ pub fn lit_backs_probing(
     log: &mut impl FnMut(&str),
     most: usize,
 ) -> Result<Option<LitBacks>, Error> {
-    let s = &job.settings;
     let Some((isect, _)) = isect else {
         return Ok(None);
     };
-    if s.mesh.two_sided || s.mesh.one_sided || !s.solve.method.casts_rays() {
+    if !probes_lit_backs(job) {
         return Ok(None);
     }
     progress.phase("looking for faces lit from behind");
-    let t = Instant::now();
-    let coarse = probe_model(job, model, most)?;
-    let (probed, probe_isect) = match &coarse {
-        Some((m, Some((i, _)))) => (m, i),
-        _ => (&*model, isect),
+    let n = surface_patches(&model.mesh);
+    let coarse = coarse_probe(job, &model.scene, model.mesh.patch_size, n, most)?;
+    let found = match coarse {
+        Some(found) => found,
+        None => shoot_probe(job, model, isect, n)?,
     };
-    // On a coarser mesh, the rays the model's own would have had (n/τ² rays for n patches).
-    let surfaces = |m: &crate::mesh::Mesh| surface_patches(m) as f64;
-    let coarser = (surfaces(&probed.mesh) / surfaces(&model.mesh)).sqrt();
+    Ok(Some(lit_backs_found(job, model, isect, found, log)))
+}
+
+/// Whether the job looks for faces lit from behind ([`lit_backs`]): not with `--two-sided`
+/// or `--one-sided`, not for the methods that cast no rays.
+pub fn probes_lit_backs(job: &SolveJob) -> bool {
+    let s = &job.settings;
+    !(s.mesh.two_sided || s.mesh.one_sided || !s.solve.method.casts_rays())
+}
+
+/// What the first shooting of [`lit_backs`] found: the light that met each polygon's back (a
+/// non-emitting one, scalar W), the light that came to rest in the model, and its counts.
+pub struct BackLight {
+    per_polygon: std::collections::BTreeMap<u32, f64>,
+    rested: f64,
+    shots: u64,
+    rays: u64,
+    probe_patches: usize,
+    seconds: f64,
+}
+
+/// [`lit_backs`]'s first shooting made before the model's own mesh, from `scene` alone, when
+/// the model will have more than [`LIT_BACKS_PROBE_PATCHES`] surface patches (counted as
+/// `mesh::rough_surface_patch_count` counts them, the mesh not yet made): it runs on a
+/// coarser cut of the scene of its own, so it can run beside the meshing of the model
+/// (`solve_into`); [`lit_backs_found`] then gives the model its back patches. `None` when the
+/// job does not look for lit backs or the model is small enough to be probed on its own mesh.
+pub fn lit_backs_ahead(job: &SolveJob, scene: &Scene) -> Result<Option<BackLight>, Error> {
+    lit_backs_ahead_probing(job, scene, LIT_BACKS_PROBE_PATCHES)
+}
+
+/// [`lit_backs_ahead`] past `most` surface patches (tests and studies set it).
+pub fn lit_backs_ahead_probing(
+    job: &SolveJob,
+    scene: &Scene,
+    most: usize,
+) -> Result<Option<BackLight>, Error> {
+    if !probes_lit_backs(job) {
+        return Ok(None);
+    }
+    let opts = &job.settings.mesh;
+    let n = crate::mesh::rough_surface_patch_count(scene, opts).round() as usize;
+    let size = crate::mesh::patch_size(scene, opts);
+    coarse_probe(job, scene, size, n, most)
+}
+
+/// The first shooting on a coarser cut of `scene` when the model (patch size `size`, `n`
+/// surface patches) has more than `most` surface patches (`probe_model`); `None` otherwise.
+fn coarse_probe(
+    job: &SolveJob,
+    scene: &Scene,
+    size: f32,
+    n: usize,
+    most: usize,
+) -> Result<Option<BackLight>, Error> {
+    let t = Instant::now();
+    let Some((coarse, Some((i, _)))) = probe_model(job, scene, size, n, most)? else {
+        return Ok(None);
+    };
+    let mut found = shoot_probe(job, &coarse, &i, n)?;
+    found.seconds = t.elapsed().as_secs_f64();
+    Ok(Some(found))
+}
+
+/// The first shooting itself, on `probed` (the model's own mesh or a coarser one) for a model
+/// of `n` surface patches: the rays the model's own mesh would have had (n/τ² rays for n
+/// patches), so a coarser mesh shoots at a coarser tolerance.
+fn shoot_probe(
+    job: &SolveJob,
+    probed: &Model,
+    probe_isect: &AnyIntersector,
+    n: usize,
+) -> Result<BackLight, Error> {
+    let t = Instant::now();
+    let s = &job.settings;
+    let coarser = (surface_patches(&probed.mesh) as f64 / n.max(1) as f64).sqrt();
     let probe = crate::solve::SolveSettings {
-        tolerance: (s.solve.tolerance.max(lit_backs_tolerance(&model.mesh)) * coarser)
+        tolerance: (s.solve.tolerance.max(lit_backs_tolerance_for(n as f64)) * coarser)
             .min(LIT_BACKS_LOOSEST),
         energy_per_ray: None,
         error_target: None,
@@ -270,16 +337,41 @@ pub fn lit_backs_probing(
             *per_polygon.entry(p.polygon).or_default() += phi;
         }
     }
+    Ok(BackLight {
+        per_polygon,
+        rested,
+        shots: sol.stats.shots,
+        rays: sol.stats.rays,
+        probe_patches: probed.mesh.patches.len(),
+        seconds: t.elapsed().as_secs_f64(),
+    })
+}
+
+/// Gives `model` back patches for the polygons whose backs the first shooting found lit
+/// (`found`; [`lit_backs`]), the most lit first, and probes its hidden sides again if any
+/// were made.
+pub fn lit_backs_found(
+    job: &SolveJob,
+    model: &mut Model,
+    isect: &AnyIntersector,
+    found: BackLight,
+    log: &mut impl FnMut(&str),
+) -> LitBacks {
+    let t = Instant::now();
+    let BackLight {
+        per_polygon,
+        rested,
+        ..
+    } = found;
     // `+ 0.0`: an empty sum is −0.0, which the summary would print as such.
     let total: f64 = per_polygon.values().sum::<f64>() + 0.0;
     let mut out = LitBacks {
         back_fraction: total / rested,
-        shots: sol.stats.shots,
-        rays: sol.stats.rays,
-        probe_patches: probed.mesh.patches.len(),
+        shots: found.shots,
+        rays: found.rays,
+        probe_patches: found.probe_patches,
         ..LitBacks::default()
     };
-    drop(coarse);
     if total >= LIT_BACKS_MIN * rested {
         let mut ranked: Vec<(u32, f64)> = per_polygon.into_iter().collect();
         ranked.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
@@ -297,7 +389,7 @@ pub fn lit_backs_probing(
         out.patches = model.mesh.add_back_twins_for(&chosen);
         // The new back patches are sides light reaches: probe again with them in place (a
         // room wound inside out looked closed from inside before).
-        model.find_hidden(isect, s.solve.seed);
+        model.find_hidden(isect, job.settings.solve.seed);
         log(&format!(
             "lit from behind: {:.1} % of the light met the backs of one-sided faces in a first shooting; {} faces given back patches ({} patches; --one-sided to keep them one-sided)",
             100.0 * out.back_fraction,
@@ -305,32 +397,34 @@ pub fn lit_backs_probing(
             out.patches
         ));
     }
-    out.seconds = t.elapsed().as_secs_f64();
-    Ok(Some(out))
+    out.seconds = found.seconds + t.elapsed().as_secs_f64();
+    out
 }
 
-/// The model [`lit_backs`] probes when it has more than `most` surface patches: the same
-/// scene cut at a patch size √(n / `most`) times its own, so about `most` patches, with its
-/// own intersector, contacts and hidden sides (the rays that leave a covered part carry no
-/// light in the probe either). The polygons are the scene's, so what the probe finds on them
-/// is given back to the model's own mesh. `None`: the model's own mesh is probed.
+/// The model [`lit_backs`] probes when the model (patch size `size`) has `n` surface patches,
+/// more than `most`: the same scene cut at a patch size √(n / `most`) times its own, so about
+/// `most` patches, with its own intersector, contacts and hidden sides (the rays that leave a
+/// covered part carry no light in the probe either). The polygons are the scene's, so what
+/// the probe finds on them is given back to the model's own mesh. `None`: the model's own
+/// mesh is probed.
 fn probe_model(
     job: &SolveJob,
-    model: &Model,
+    scene: &Scene,
+    size: f32,
+    n: usize,
     most: usize,
 ) -> Result<Option<(Model, SolveIntersector)>, Error> {
-    let n = surface_patches(&model.mesh);
     if n <= most {
         return Ok(None);
     }
     let s = &job.settings;
     let opts = crate::mesh::MeshOptions {
-        patch_size: Some(model.mesh.patch_size * (n as f32 / most as f32).sqrt()),
+        patch_size: Some(size * (n as f32 / most as f32).sqrt()),
         two_sided: false,
         one_sided: false,
         uniform_patches: true,
     };
-    let mut coarse = Model::from_scene(model.scene.clone(), &opts)?;
+    let mut coarse = Model::from_scene(scene.clone(), &opts)?;
     let isect = coarse.intersector_for(s.solve.method, s.intersector)?;
     let Some((i, _)) = &isect else {
         return Ok(None);

@@ -241,7 +241,8 @@ fn the_warnings_name_the_flag() {
 /// coarser cut of the scene. On the office wound both ways, probed on a cut of about half its
 /// patches, as many faces get back patches as its own mesh's probe gives (within a tenth), the
 /// light left on backs afterwards is within the probe's own noise, and the probe ran on the
-/// coarser mesh.
+/// coarser mesh — also when the cut is made from the scene alone, before the model's mesh
+/// (as a solve of a large model makes it, beside the meshing).
 #[test]
 fn a_coarser_probe_finds_the_faces_lit_from_behind() {
     use radiosity::pipeline::{stages, SolveJob};
@@ -280,6 +281,23 @@ fn a_coarser_probe_finds_the_faces_lit_from_behind() {
     };
     let (own, own_back, n) = probed(usize::MAX);
     let (coarse, coarse_back, _) = probed(n / 2);
+    // The same probe made from the scene alone, before (beside) the model's mesh, as a solve
+    // of a large model makes it: the model's patches counted before the cuts near lights.
+    let ahead = {
+        let mut log = |_: &str| {};
+        let scene = stages::load(&job, &progress, &mut log).unwrap();
+        let found = stages::lit_backs_ahead_probing(&job, &scene, n / 2)
+            .unwrap()
+            .expect("past n / 2 the probe runs on a coarser cut");
+        let mut model = stages::mesh(&job, scene, &progress, &mut log).unwrap();
+        let isect = stages::intersect(&job, &model, &progress, &mut log).unwrap();
+        stages::sides(&job, &mut model, isect.as_ref(), &progress, &mut log);
+        let (i, _) = isect.as_ref().expect("the office casts rays");
+        stages::lit_backs_found(&job, &mut model, i, found, &mut log)
+    };
+    assert!(ahead.probe_patches < 3 * n / 4, "{ahead:?} of {n}");
+    let (o, c) = (own.polygons as f64, ahead.polygons as f64);
+    assert!((o - c).abs() <= 0.1 * o, "{own:?} against {ahead:?}");
     assert_eq!(own.probe_patches, n);
     assert!(coarse.probe_patches < 3 * n / 4, "{coarse:?} of {n}");
     assert!(own.polygons > 0, "{own:?}");
