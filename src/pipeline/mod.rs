@@ -261,12 +261,16 @@ fn solve_into(
     // probe for faces lit from behind when the model is too large to be probed on its own mesh
     // (`stages::lit_backs_ahead`: it cuts the scene coarser for itself). Its seconds are
     // `lit_backs.seconds`; the sides stage counts any wait for it.
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
     let (built, ahead) = std::thread::scope(|threads| {
         let ahead = stages::probes_lit_backs(job).then(|| {
-            let scene = scene.clone();
-            threads.spawn(move || stages::lit_backs_ahead(job, &scene))
+            let (scene, stop) = (scene.clone(), stop.clone());
+            threads.spawn(move || stages::lit_backs_ahead(job, &scene, stop))
         });
         let built = mesh_and_sides(job, scene, progress, log, &mut timings);
+        if built.is_err() {
+            stop.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
         (built, ahead.map(|probe| probe.join()))
     });
     let (mut model, isect, sides_clock) = built?;

@@ -13,6 +13,8 @@ use crate::scene::Scene;
 use crate::sky::Sky;
 use crate::solve::{RunHooks, Solution, TracePoint};
 use crate::Error;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// The solve's intersector and why it was chosen; `None` for the methods that cast no rays.
@@ -229,10 +231,11 @@ pub fn lit_backs_probing(
     }
     progress.phase("looking for faces lit from behind");
     let n = surface_patches(&model.mesh);
-    let coarse = coarse_probe(job, &model.scene, model.mesh.patch_size, n, most)?;
+    let hooks = RunHooks::default();
+    let coarse = coarse_probe(job, &model.scene, (model.mesh.patch_size, n, most), &hooks)?;
     let found = match coarse {
         Some(found) => found,
-        None => shoot_probe(job, model, isect, n)?,
+        None => shoot_probe(job, model, isect, n, &hooks)?,
     };
     Ok(Some(lit_backs_found(job, model, isect, found, log)))
 }
@@ -261,8 +264,15 @@ pub struct BackLight {
 /// coarser cut of the scene of its own, so it can run beside the meshing of the model
 /// (`solve_into`); [`lit_backs_found`] then gives the model its back patches. `None` when the
 /// job does not look for lit backs or the model is small enough to be probed on its own mesh.
-pub fn lit_backs_ahead(job: &SolveJob, scene: &Scene) -> Result<Option<BackLight>, Error> {
-    lit_backs_ahead_probing(job, scene, LIT_BACKS_PROBE_PATCHES)
+/// Nor when the model's mesh will be refused (a bad or too fine `--patch-size`: the mesh
+/// stage says so). `stop`, once set (the model's own stages failed), ends its shooting at
+/// the next safe point: nothing waits long for a probe nobody needs.
+pub fn lit_backs_ahead(
+    job: &SolveJob,
+    scene: &Scene,
+    stop: Arc<AtomicBool>,
+) -> Result<Option<BackLight>, Error> {
+    lit_backs_ahead_probing(job, scene, LIT_BACKS_PROBE_PATCHES, Some(stop))
 }
 
 /// [`lit_backs_ahead`] past `most` surface patches (tests and studies set it).
@@ -270,14 +280,23 @@ pub fn lit_backs_ahead_probing(
     job: &SolveJob,
     scene: &Scene,
     most: usize,
+    stop: Option<Arc<AtomicBool>>,
 ) -> Result<Option<BackLight>, Error> {
-    if !probes_lit_backs(job) {
+    let opts = &job.settings.mesh;
+    if !probes_lit_backs(job) || opts.check().is_err() {
         return Ok(None);
     }
-    let opts = &job.settings.mesh;
+    let all = crate::mesh::rough_patch_count(scene, opts);
+    if all.is_nan() || all > crate::mesh::MAX_PATCHES {
+        return Ok(None);
+    }
     let n = crate::mesh::rough_surface_patch_count(scene, opts).round() as usize;
     let size = crate::mesh::patch_size(scene, opts);
-    coarse_probe(job, scene, size, n, most)
+    let hooks = RunHooks {
+        interrupt: stop,
+        ..RunHooks::default()
+    };
+    coarse_probe(job, scene, (size, n, most), &hooks)
 }
 
 /// The first shooting on a coarser cut of `scene` when the model (patch size `size`, `n`
@@ -285,15 +304,14 @@ pub fn lit_backs_ahead_probing(
 fn coarse_probe(
     job: &SolveJob,
     scene: &Scene,
-    size: f32,
-    n: usize,
-    most: usize,
+    (size, n, most): (f32, usize, usize),
+    hooks: &RunHooks,
 ) -> Result<Option<BackLight>, Error> {
     let t = Instant::now();
     let Some((coarse, Some((i, _)))) = probe_model(job, scene, size, n, most)? else {
         return Ok(None);
     };
-    let mut found = shoot_probe(job, &coarse, &i, n)?;
+    let mut found = shoot_probe(job, &coarse, &i, n, hooks)?;
     found.seconds = t.elapsed().as_secs_f64();
     Ok(Some(found))
 }
@@ -306,6 +324,7 @@ fn shoot_probe(
     probed: &Model,
     probe_isect: &AnyIntersector,
     n: usize,
+    hooks: &RunHooks,
 ) -> Result<BackLight, Error> {
     let t = Instant::now();
     let s = &job.settings;
@@ -319,7 +338,7 @@ fn shoot_probe(
         stop_unshot: Some(LIT_BACKS_UNSHOT),
         ..s.solve.clone()
     };
-    let sol = probed.solve(Some(probe_isect), &probe, &Default::default(), |_| {})?;
+    let sol = probed.solve(Some(probe_isect), &probe, hooks, |_| {})?;
     // What met backs is measured against the light that came to rest in the model before the
     // probe stopped (a sky's light that missed it never was in it): the share the rest would
     // leave on backs too.

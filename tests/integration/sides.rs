@@ -286,7 +286,7 @@ fn a_coarser_probe_finds_the_faces_lit_from_behind() {
     let ahead = {
         let mut log = |_: &str| {};
         let scene = stages::load(&job, &progress, &mut log).unwrap();
-        let found = stages::lit_backs_ahead_probing(&job, &scene, n / 2)
+        let found = stages::lit_backs_ahead_probing(&job, &scene, n / 2, None)
             .unwrap()
             .expect("past n / 2 the probe runs on a coarser cut");
         let mut model = stages::mesh(&job, scene, &progress, &mut log).unwrap();
