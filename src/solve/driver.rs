@@ -198,9 +198,10 @@ struct Pending {
 enum Step {
     /// Stop, for this reason (its last trace point recorded).
     Stop(StopReason),
-    /// Land the wave in flight, then look again.
+    /// Land the wave in flight, then look again: nothing to shoot until it lands, or its
+    /// deposits may change the stop rule's verdict.
     Land,
-    /// Shoot these ray shots (none: land the wave in flight first).
+    /// Shoot these ray shots (never none).
     Rays(Vec<RayShot>),
     /// Shoot a wave of hemi-cubes.
     Cubes,
@@ -512,12 +513,7 @@ impl<'a, I: Intersector> Driver<'a, I> {
             reported = self.stats.trace.len();
             match step {
                 Step::Stop(r) => return Ok(r),
-                // Nothing to shoot until the wave in flight lands, or deposits still in flight
-                // may change the stop rule's verdict: apply them and look again.
                 Step::Land => {
-                    self.land_pending();
-                }
-                Step::Rays(wave) if wave.is_empty() => {
                     self.land_pending();
                 }
                 Step::Rays(wave) => self.ray_wave(wave, start),
@@ -548,9 +544,13 @@ impl<'a, I: Intersector> Driver<'a, I> {
             self.next_trace_shots = (self.stats.shots as f64 * 1.25) as u64 + 8;
         }
         if self.cubes.is_some() {
-            Step::Cubes
+            return Step::Cubes;
+        }
+        let wave = self.take_ray_wave(progress.samples);
+        if wave.is_empty() {
+            Step::Land
         } else {
-            Step::Rays(self.take_ray_wave(progress.samples))
+            Step::Rays(wave)
         }
     }
 
