@@ -685,7 +685,7 @@ pub(super) fn run<I: Intersector>(
             &mut work,
             &r.near,
             |i, w, root, uv| r.at(i, w, root, uv),
-            |i, x| r.gather_part(i, x, LightParts::Indirect, r.indirect_rays),
+            |i, x| r.gather_part(i, x, LightParts::IndirectOnce, r.indirect_rays),
             &mut values,
         );
     }

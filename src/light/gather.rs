@@ -24,6 +24,25 @@ pub enum LightParts {
     /// The hemisphere rays alone: what they meet, emitters at the complement of the weight
     /// `Direct` gives them. `Direct` + `Indirect` is `All` in expectation.
     Indirect,
+    /// `Indirect` with a near hit followed one step, not [`super::NEAR_DEPTH`] ([`super::NEAR`]:
+    /// the point met then takes the solution's B − E of what its own ray meets, near or not).
+    /// What the adaptive elements' indirect nodes gather (`crate::elements`): they give the
+    /// light's shape across a patch whose level the final gather (which follows three deep)
+    /// has set, and each step followed is a path of one light sample and one ray, the noisiest
+    /// and costliest part of a node (docs/results/adaptive-elements.md).
+    IndirectOnce,
+}
+
+impl LightParts {
+    /// Whether the emitters' and the sun's light samples (and a patch's own emission) are in.
+    pub fn direct(self) -> bool {
+        matches!(self, LightParts::All | LightParts::Direct)
+    }
+
+    /// Whether the hemisphere rays are cast.
+    pub fn hemisphere(self) -> bool {
+        self != LightParts::Direct
+    }
 }
 
 /// One gather: irradiance H (RGB), per light channel, the scalar variance of ρ·H's mean, and
@@ -81,6 +100,8 @@ pub(super) struct Split {
     pub grid: PolarGrid,
     pub nl: f64,
     pub nc: f64,
+    /// How many near hits one after another a hemisphere ray's path follows ([`super::NEAR`]).
+    pub follow: u32,
 }
 
 impl Split {
@@ -88,7 +109,7 @@ impl Split {
     fn new(parts: LightParts, draw: Option<Draw>, sun: bool, rays_wanted: usize) -> Split {
         let lamps = draw.is_some();
         let (direct, n_sun) = match (parts, lamps, sun) {
-            (LightParts::Indirect, _, _) => (0, 0),
+            (LightParts::Indirect | LightParts::IndirectOnce, _, _) => (0, 0),
             (LightParts::All, l, s) => (
                 if l { (rays_wanted / 2).max(1) } else { 0 },
                 if s { (rays_wanted / 4).max(1) } else { 0 },
@@ -111,7 +132,7 @@ impl Split {
         // emitter, at a room's corner).
         let (nl, nc) = match parts {
             LightParts::All => (direct as f64, grid.len() as f64),
-            LightParts::Direct | LightParts::Indirect => (if lamps { 1.0 } else { 0.0 }, 1.0),
+            _ => (if lamps { 1.0 } else { 0.0 }, 1.0),
         };
         Split {
             draw: draw.unwrap_or_else(Draw::by_power),
@@ -120,6 +141,11 @@ impl Split {
             grid,
             nl,
             nc,
+            follow: if parts == LightParts::IndirectOnce {
+                1
+            } else {
+                super::NEAR_DEPTH
+            },
         }
     }
 }
@@ -180,10 +206,10 @@ impl<I: Intersector> Kernel<'_, I> {
         if let Some(sun) = sun.filter(|_| split.sun > 0) {
             self.sun_part(spot, sun, split.sun, &mut g, rng);
         }
-        if !self.mesh.luminaires.is_empty() && ask.parts != LightParts::Indirect {
+        if !self.mesh.luminaires.is_empty() && ask.parts.direct() {
             self.luminaires_part(spot, ask.rays, &mut g, rng);
         }
-        if ask.parts != LightParts::Direct {
+        if ask.parts.hemisphere() {
             self.hemisphere_part(spot, &split, &mut g, rng);
         }
         if let Some(l) = learned {

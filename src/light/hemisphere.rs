@@ -196,7 +196,7 @@ impl<I: Intersector> Kernel<'_, I> {
                         (split.nl, split.nc),
                     );
                 }
-                sub = self.reflected_at(r, (org + dir * t, t), 0, &split.draw, rng);
+                sub = self.reflected_at(r, (org + dir * t, t), split.follow, &split.draw, rng);
                 g.rays += sub.rays;
             }
             if seen.hit.is_none() {
@@ -227,24 +227,24 @@ impl<I: Intersector> Kernel<'_, I> {
     /// `t` (RGB, and per channel). From afar, the solution's B_r − E_r. From nearer than r's
     /// size (√A_r · [`NEAR`]), where a constant B over r is not what this point sees (the wall
     /// behind a shelf 5 cm in front of it is dark, the 0.5 m wall patch is not), ρ_r times the
-    /// irradiance at `y` itself ([`Self::followed`]), at most [`NEAR_DEPTH`] times: a path
-    /// followed through the narrow gap until it leaves it (the close-hit rule of final
-    /// gathers, Jensen, *Realistic Image Synthesis Using Photon Mapping*, 2001, Sec. 9.4.2,
-    /// with the solution as the cache).
+    /// irradiance at `y` itself ([`Self::followed`]), `left` more times at most
+    /// ([`NEAR_DEPTH`] from a gather's own rays): a path followed through the narrow gap until
+    /// it leaves it (the close-hit rule of final gathers, Jensen, *Realistic Image Synthesis
+    /// Using Photon Mapping*, 2001, Sec. 9.4.2, with the solution as the cache).
     fn reflected_at<R: Rng>(
         &self,
         r: usize,
         (y, t): (Vec3, f32),
-        depth: u32,
+        left: u32,
         near_draw: &Draw,
         rng: &mut R,
     ) -> Reflected {
         let area = self.mesh.patches[r].area as f32;
         let near = t < NEAR * area.sqrt();
-        if depth >= NEAR_DEPTH || !near || scalar(self.sol.rho[r]) <= 0.0 {
+        if left == 0 || !near || scalar(self.sol.rho[r]) <= 0.0 {
             return self.solved(r);
         }
-        self.followed(r, y, depth, near_draw, rng)
+        self.followed(r, y, left, near_draw, rng)
     }
 
     /// A followed point's emitter for the number `s` ∈ [0, 1), drawn from `mix`
@@ -293,13 +293,13 @@ impl<I: Intersector> Kernel<'_, I> {
     }
 
     /// ρ_r times the irradiance at `y` on side `r`, from one light sample, one cosine-weighted
-    /// ray (its hit taken by [`Self::reflected_at`] one level deeper), one sun sample and one
-    /// luminaire's light.
+    /// ray (its hit taken by [`Self::reflected_at`] one level deeper, `left` − 1 more near
+    /// hits to follow), one sun sample and one luminaire's light.
     fn followed<R: Rng>(
         &self,
         r: usize,
         y: Vec3,
-        depth: u32,
+        left: u32,
         near_draw: &Draw,
         rng: &mut R,
     ) -> Reflected {
@@ -375,7 +375,7 @@ impl<I: Intersector> Kernel<'_, I> {
         }
         if let Some((s, t2)) = self.receiver_of(hit) {
             let emitted = self.emitted_towards(s, (n, dir, t2), &mix, (nl, 1.0));
-            let sub = self.reflected_at(s, (x + dir * t2, t2), depth + 1, near_draw, rng);
+            let sub = self.reflected_at(s, (x + dir * t2, t2), left - 1, near_draw, rng);
             acc.rays += sub.rays;
             acc.v += w * (sub.v + emitted);
             for (c, chc) in acc.ch.iter_mut().enumerate() {

@@ -221,7 +221,8 @@ impl<'a, I: Intersector> LightAt<'a, I> {
     /// [`Self::radiosity_at`]'s `parts` of the light: `All` is B = E + ρ·H; `Direct` is
     /// E + ρ·H_direct (the emitters and the sun by shadow rays, all `rays` theirs); `Indirect`
     /// is ρ·H_indirect (the hemisphere, the emitters' light left out). `Direct` and `Indirect`
-    /// add up to `All`'s B in expectation. Returns the value, the variance of the scalar ρ·H
+    /// add up to `All`'s B in expectation (`IndirectOnce` is `Indirect` with near hits
+    /// followed one step, not three). Returns the value, the variance of the scalar ρ·H
     /// it gathered (of its mean; 0 where nothing was gathered) and the rays cast.
     pub fn part_at<R: Rng>(
         &self,
@@ -233,11 +234,7 @@ impl<'a, I: Intersector> LightAt<'a, I> {
     ) -> (Rgb, f64, u64) {
         let k = &self.kernel;
         let (e, rho) = (k.sol.e[patch], k.sol.rho[patch]);
-        let e = if parts == LightParts::Indirect {
-            Rgb::ZERO
-        } else {
-            e
-        };
+        let e = if parts.direct() { e } else { Rgb::ZERO };
         if points.is_empty() || scalar(rho) <= 0.0 {
             return (e, 0.0, 0);
         }
