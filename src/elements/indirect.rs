@@ -18,22 +18,28 @@
 //! (the whole gather at every corner: 0.76 %). README, "Adaptive elements", has the costs.
 //!
 //! **Which patches.** Only those that see geometry near enough to bend their indirect light
-//! within them ([`near_patches`]: Ward, Rubinstein & Clear's criterion from the harmonic mean
-//! distance of what a patch sees, measured with a few probe rays). Elsewhere the indirect light
+//! within them by more than the threshold of their whole light ([`near_patches`]: Ward,
+//! Rubinstein & Clear's criterion from the harmonic mean distance of what a patch sees, times
+//! the indirect light's share of the patch's radiosity, both measured with a few probe rays).
+//! Elsewhere the indirect light
 //! is as smooth as the patch solution draws it, and the final gather has measured every
 //! patch's B with more rays than a node gets: such a patch's points gather the direct light
 //! only, its indirect light is the patch solution's (B less its elements' mean direct light,
 //! averaged to the welded vertices, as [`super::CornerLight::Direct`] takes it), at no
-//! hemisphere ray. On the office 803 of 2,092 patches gather nodes; on `scenes/spot.obj` that
-//! lowered the error too (1.19 → 1.14 % at the default mesh: the patches' estimates are less
-//! noisy than 64-ray nodes; docs/results/adaptive-elements.md).
+//! hemisphere ray. On the office 581 of 2,092 patches gather nodes (803 before the share was
+//! weighed in), on a generated 100 k-patch building 31,317 of 97,703 (42,219); on
+//! `scenes/spot.obj` leaving the rest to the patch solution lowered the error too (1.19 → 1.14
+//! % at the default mesh: the patches' estimates are less noisy than 64-ray nodes;
+//! docs/results/adaptive-elements.md).
 //!
 //! **Which nodes.** Every root's corners first (about one distinct point a patch, shared);
-//! only a patch whose corners' indirect light differs by more than [`SPREAD`] gathers its
-//! midpoints and centre and is interpolated quadratically, the others bilinearly: where the
-//! corners agree, the light between them is as flat as the noise can tell.
+//! only a patch whose corners' indirect light differs by more than [`SPREAD`], beyond what
+//! their own noise explains, gathers its midpoints and centre and is interpolated
+//! quadratically, the others bilinearly: where the corners agree, the light between them is
+//! as flat as the noise can tell.
 
 use super::geometry::Elem;
+use super::refine::NOISE_Z;
 use super::work::{gather_new, At, PatchWork, Values};
 use crate::intersect::Intersector;
 use crate::light::LightAt;
@@ -123,7 +129,8 @@ fn weights(n: usize, uv: DVec2) -> Vec<f64> {
 }
 
 /// A patch whose corners' indirect light differs by more than this fraction of their mean
-/// gathers the rest of its nodes (edge midpoints, a quad's centre) and is interpolated
+/// (the difference of the two farthest apart less [`NOISE_Z`] standard deviations of their
+/// noise, in quadrature) gathers the rest of its nodes (edge midpoints, a quad's centre) and is interpolated
 /// quadratically; below it, bilinearly from its corners (0.05–0.3 measured alike on
 /// `scenes/spot.obj`, 0.3 the fewest rays; docs/results/adaptive-elements.md).
 pub const SPREAD: f64 = 0.3;
@@ -190,11 +197,19 @@ pub(super) fn gather(
     let mut all = vec![false; work.len()];
     let spread: Vec<bool> = (near_ones.par_iter())
         .map(|&i| {
-            let s: Vec<f64> = (points(i, &work[i], false).iter().flatten())
-                .map(|(a, _)| scalar(&v.indirect[a].0))
+            let s: Vec<(f64, f64)> = (points(i, &work[i], false).iter().flatten())
+                .map(|(a, _)| (scalar(&v.indirect[a].0), v.indirect[a].1))
                 .collect();
-            let (lo, hi) = (s.iter()).fold((f64::MAX, 0.0f64), |(l, h), &x| (l.min(x), h.max(x)));
-            hi - lo > SPREAD * s.iter().sum::<f64>() / s.len().max(1) as f64
+            let lo = s.iter().copied().min_by(|a, b| a.0.total_cmp(&b.0));
+            let hi = s.iter().copied().max_by(|a, b| a.0.total_cmp(&b.0));
+            let (Some(lo), Some(hi)) = (lo, hi) else {
+                return false;
+            };
+            let mean = s.iter().map(|x| x.0).sum::<f64>() / s.len() as f64;
+            // The difference less what the two nodes' noise explains (in quadrature, as the
+            // refinement's test takes it off: `refine::NOISE_Z`).
+            let d2 = (hi.0 - lo.0).powi(2) - NOISE_Z * NOISE_Z * (hi.1 + lo.1);
+            d2 > (SPREAD * mean).powi(2)
         })
         .collect();
     for (&i, &wide) in near_ones.iter().zip(&spread) {
@@ -231,16 +246,21 @@ pub const PROBE_SIDE: usize = 4;
 /// 1988, Sec. 2.2): the indirect irradiance at a point changes over a distance d by about
 /// d/R of itself, R the harmonic mean distance of the surfaces the point sees, so across a
 /// patch of size s = √A by about s/R, and what bilinear interpolation between its corners
-/// misses (the curvature) by about (s/R)²/8. A patch where that exceeds `threshold` (the
-/// elements' own, `--element-threshold`) sees geometry near enough to shape its indirect light
-/// (a contact, a wall's edge, under a table) and gathers it at its nodes; the others take
-/// theirs from the patch solution (the final gather's estimate, averaged to the vertices), at
-/// no ray. R is measured from each patch's centre with [`PROBE_SIDE`]² cosine-weighted rays
-/// (a ray that leaves the model counts as infinitely far), drawn from (seed,
-/// [`Stream::Elements`], 2⁶³ + patch).
+/// misses (the curvature) by about (s/R)²/8 of the indirect light — of the patch's radiosity
+/// B, times the indirect light's share of it, ρ·H_ind / B. A patch where that exceeds
+/// `threshold` (the elements' own, `--element-threshold`, which weighs differences against
+/// the whole light too) sees geometry near enough to shape a light that shows (a contact, a
+/// wall's edge, under a table) and gathers it at its nodes; the others take theirs from the
+/// patch solution (the final gather's estimate, averaged to the vertices), at no ray. Beside
+/// a lamp, where the direct light is most of B, the indirect light's bend is lost in it; under
+/// a table, where it is all of B, it is what shows. R and H_ind are measured from each
+/// patch's centre with the same [`PROBE_SIDE`]² cosine-weighted rays (a ray that leaves the
+/// model counts as infinitely far; H_ind is the mean of what the solution says the rays see,
+/// [`LightAt::seen_light`]), drawn from (seed, [`Stream::Elements`], 2⁶³ + patch).
 pub(super) fn near_patches<I: Intersector>(
     mesh: &Mesh,
     light: &LightAt<'_, I>,
+    b: &[[f64; 3]],
     seed: u64,
     threshold: f64,
 ) -> (Vec<bool>, u64) {
@@ -249,6 +269,12 @@ pub(super) fn near_patches<I: Intersector>(
         .into_par_iter()
         .map(|i| {
             let p = &mesh.patches[i];
+            let whole = scalar(&b[i]);
+            let rho = light.reflectance(i);
+            if whole <= 0.0 || scalar(&rho.to_array()) <= 0.0 {
+                // Nothing reflected, or nothing shown: no indirect light to shape.
+                return (false, 0);
+            }
             let s = p.area.sqrt();
             let mut rng = rng_for(seed, Stream::Elements, (1 << 63) | i as u64);
             let frame = Frame::new(p.normal, rng.gen::<f32>() * std::f32::consts::TAU);
@@ -256,19 +282,23 @@ pub(super) fn near_patches<I: Intersector>(
                 + p.normal
                     * (1e-4 * s as f32).max(f32::EPSILON * p.centre.abs().max_element() * 16.0);
             let (mut inv, mut rays) = (0.0f64, 0u64);
+            let mut h = crate::light::Rgb::ZERO;
             for k in 0..n {
                 let u1 = ((k / PROBE_SIDE) as f32 + rng.gen::<f32>()) / PROBE_SIDE as f32;
                 let u2 = ((k % PROBE_SIDE) as f32 + rng.gen::<f32>()) / PROBE_SIDE as f32;
                 let (r, phi) = (u1.sqrt(), std::f32::consts::TAU * u2);
                 let d = Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt());
-                let seen = light.view(org, frame.to_world(d));
+                let dir = frame.to_world(d);
+                let seen = light.view(org, dir);
                 rays += seen.rays;
-                if let Some(h) = seen.hit {
-                    inv += 1.0 / (h.point - org).length().max(f32::MIN_POSITIVE) as f64;
+                h += light.seen_light(&seen, dir);
+                if let Some(hit) = &seen.hit {
+                    inv += 1.0 / (hit.point - org).length().max(f32::MIN_POSITIVE) as f64;
                 }
             }
             let ratio = s * inv / n as f64;
-            (ratio * ratio / 8.0 > threshold, rays)
+            let share = (scalar(&(rho * h).to_array()) / n as f64 / whole).min(1.0);
+            (ratio * ratio / 8.0 * share > threshold, rays)
         })
         .collect();
     let rays = got.iter().map(|g| g.1).sum();

@@ -380,7 +380,7 @@ pub fn refine_by<I: Intersector>(
     };
     // Split: which patches see geometry near enough to gather their indirect light at nodes.
     let (near, probe_rays) = match light {
-        CornerLight::Split => indirect::near_patches(mesh, gather, seed, threshold),
+        CornerLight::Split => indirect::near_patches(mesh, gather, b, seed, threshold),
         _ => (Vec::new(), 0),
     };
     let indirect_patches = near.iter().filter(|&&n| n).count() as u64;

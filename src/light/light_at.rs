@@ -302,6 +302,24 @@ impl<'a, I: Intersector> LightAt<'a, I> {
         self.kernel.sky.exitance(dir)
     }
 
+    /// What the light a ray brings from what it saw (`seen`, along `dir`) is worth as
+    /// irradiance from a cosine-weighted direction: the B − E of the side it met or the sky's
+    /// exitance where it left, through the glazing it passed, and the panes' own (RGB, W/m²;
+    /// the mean over cosine-weighted rays is the irradiance from the solution and the sky).
+    pub fn seen_light(&self, seen: &ViewSeen, dir: Vec3) -> Rgb {
+        let k = &self.kernel;
+        let far = match &seen.hit {
+            Some(h) => k.sol.reflected(h.patch),
+            None => k.sky.exitance(dir),
+        };
+        seen.panes + seen.through * far
+    }
+
+    /// The reflectance ρ of patch `patch` (RGB).
+    pub fn reflectance(&self, patch: usize) -> Rgb {
+        self.kernel.sol.rho[patch]
+    }
+
     /// The mesh the light is gathered in.
     pub fn mesh(&self) -> &Mesh {
         self.kernel.mesh
