@@ -39,8 +39,8 @@
 //! as flat as the noise can tell.
 
 use super::geometry::Elem;
-use super::refine::NOISE_Z;
 use super::work::{gather_new, At, PatchWork, Values};
+use super::NOISE_Z;
 use crate::intersect::Intersector;
 use crate::light::LightAt;
 use crate::mesh::Mesh;
@@ -207,7 +207,7 @@ pub(super) fn gather(
             };
             let mean = s.iter().map(|x| x.0).sum::<f64>() / s.len() as f64;
             // The difference less what the two nodes' noise explains (in quadrature, as the
-            // refinement's test takes it off: `refine::NOISE_Z`).
+            // refinement's test takes it off: `NOISE_Z`).
             let d2 = (hi.0 - lo.0).powi(2) - NOISE_Z * NOISE_Z * (hi.1 + lo.1);
             d2 > (SPREAD * mean).powi(2)
         })

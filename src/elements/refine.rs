@@ -44,6 +44,7 @@
 use super::geometry::{Cut, Elem, Root};
 pub(super) use super::work::{facing, inner_edges, key, At, PatchWork, Values};
 use super::work::{gather_new, on_edges};
+use super::NOISE_Z;
 use crate::intersect::Intersector;
 use crate::light::{LightAt, LightParts};
 use crate::mesh::Mesh;
@@ -510,17 +511,6 @@ impl<I: Intersector> Refiner<'_, I> {
         (contrast > threshold).then_some((contrast, how))
     }
 }
-
-/// The test takes this many standard deviations of the indirect nodes' noise
-/// ([`Refiner::test_noise`]) off a difference (in quadrature: √(d² − z²σ²)) before it weighs
-/// it against the threshold: in a uniformly lit room the differences are that noise alone,
-/// and a threshold on the light cannot tell them from a shadow's. Measured on a closed box
-/// whose every patch emits (the furnace test; seeds 1–20, split corners at 64 rays): 8
-/// elements cut in all with nothing taken off, 2 with one σ, none with 1.5, 2 or 3; on
-/// `bench elements scenes/spot.obj --tests halves` at 0.02: 1.19 % error with nothing taken
-/// off, 1.22 % with 1.5, 1.23 % with 2 (ratio 0.49 to uniform meshing). A bare cut-off (cut
-/// only above 3σ) left one cut in the 20 and 1.27 % (docs/results/adaptive-elements.md).
-pub(super) const NOISE_Z: f64 = 2.0;
 
 /// Whether `e` is at least twice the smallest element edge along its longer side.
 fn big_enough(e: &Elem, w: &PatchWork, min_size: f64) -> bool {
