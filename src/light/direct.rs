@@ -72,12 +72,14 @@ impl<I: Intersector> Kernel<'_, I> {
 
     /// One light sample from `from` to the point `y` of emitter `e` (an index into the
     /// emitters, picked with probability `mass`), its shadow ray weighed by MIS against `n_l`
-    /// light samples and `n_c` hemisphere rays and divided by the sample's density. Returns
-    /// the sample (RGB; 0 when not seen), the emitting patch, and whether a ray was cast.
+    /// light samples and `n_c` hemisphere rays as if `e` were picked with probability
+    /// `w_mass` (`mass` itself but in a gather split in parts: [`Split::weigh`]) and divided
+    /// by the sample's density. Returns the sample (RGB; 0 when not seen), the emitting
+    /// patch, and whether a ray was cast.
     pub(super) fn light_sample(
         &self,
         from: &Origin,
-        (e, mass): (usize, f64),
+        (e, mass, w_mass): (usize, f64, f64),
         y: Vec3,
         (n_l, n_c): (f64, f64),
     ) -> (Rgb, usize, bool) {
@@ -88,7 +90,7 @@ impl<I: Intersector> Kernel<'_, I> {
         let cast = shadow.is_some();
         let (c, mis) = shadow.map_or((Rgb::ZERO, 0.0), |sh| {
             let geometry = (sh.cos_i, sh.cos_j, sh.dist);
-            (sh.e_g, Emitters::weight(mass, area, geometry, n_l, n_c))
+            (sh.e_g, Emitters::weight(w_mass, area, geometry, n_l, n_c))
         });
         // ÷ pdf(y) = mass / A_j, × the light sample's MIS weight.
         let scale = area / mass * mis;
@@ -117,7 +119,15 @@ impl<I: Intersector> Kernel<'_, I> {
             // Stratified choice of the emitter, then a point on it from the rest of `s`.
             let (e, mass, s2, node) = self.emitters.pick_node(&split.draw, f64::from(s));
             let y = self.emitters.at[e].points.at(s2, t);
-            let (val, j, cast) = self.light_sample(&from, (e, mass), y, (split.nl, split.nc));
+            let w_mass = match &split.weigh {
+                Some(w) => {
+                    let em = &self.emitters.at[e];
+                    self.emitters.mass(w, e, scalar(em.e) * em.area)
+                }
+                None => mass,
+            };
+            let sample = (e, mass, w_mass);
+            let (val, j, cast) = self.light_sample(&from, sample, y, (split.nl, split.nc));
             if let (Some(l), Some(node)) = (learned.as_deref_mut(), node) {
                 l.record(node, scalar(val) > 0.0);
             }

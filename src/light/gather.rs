@@ -11,6 +11,7 @@ use crate::sample::polar::PolarGrid;
 use glam::Vec3;
 use rand::seq::SliceRandom;
 use rand::Rng;
+use std::cell::RefCell;
 
 /// Which parts of the light a gather samples (the final-gather renderer gathers the indirect
 /// light at a few points of the image and interpolates it: [`super::LightAt::part_at`]).
@@ -102,6 +103,12 @@ pub(super) struct Split {
     pub nc: f64,
     /// How many near hits one after another a hemisphere ray's path follows ([`super::NEAR`]).
     pub follow: u32,
+    /// What the MIS weights between the light samples and the hemisphere rays take for the
+    /// light samples' density, when not `draw`'s own: a gather split in parts samples its
+    /// patch's cut but weighs by power, so that the weights of a path still add up to one
+    /// wherever its two parts are gathered (any weights that do are unbiased; by power they
+    /// are the same at every point, and so is what each part holds in expectation).
+    pub weigh: Option<Draw>,
 }
 
 impl Split {
@@ -141,6 +148,7 @@ impl Split {
             grid,
             nl,
             nc,
+            weigh: (parts != LightParts::All && lamps).then(Draw::by_power),
             follow: if parts == LightParts::IndirectOnce {
                 1
             } else {
@@ -174,12 +182,19 @@ impl<I: Intersector> Kernel<'_, I> {
             rays: 0,
         };
         let lamps = !self.emitters.is_empty() && ask.lights;
-        // A whole gather draws its emitters by what they can give this spot (none: no light
-        // samples at all); a gather split in parts, each gathered at other points
-        // (`LightParts`), by power, so that the parts' MIS weights still add up to one.
+        // A gather draws its emitters by what they can give its spot (none: no light samples
+        // at all); a patch's gather split in parts (`LightParts`) by what they can give its
+        // whole polygon (`Kernel::polygon_draw`), its MIS weights by power (`Split::weigh`):
+        // drawn by power over the whole model, most of a point's light samples went to other
+        // rooms' lamps. What earlier gathers learnt (`learned`) only shapes a whole gather's.
+        // A point in the air split in parts draws by power.
         let draw = match (lamps, ask.parts) {
             (false, _) => None,
-            (true, LightParts::All) => {
+            (true, parts) if parts != LightParts::All && spot.patch == super::NO_PATCH => {
+                Some(Draw::by_power())
+            }
+            (true, parts) if parts != LightParts::All => self.polygon_draw(spot),
+            (true, _) => {
                 let r = self.receiver(spot);
                 let l = learned.as_deref();
                 let draw = match l.and_then(Learned::shared_cut) {
@@ -196,7 +211,6 @@ impl<I: Intersector> Kernel<'_, I> {
                     None => d,
                 })
             }
-            (true, _) => Some(Draw::by_power()),
         };
         let sun = self.sky.sun();
         let split = Split::new(ask.parts, draw, sun.is_some(), ask.rays);
@@ -219,7 +233,51 @@ impl<I: Intersector> Kernel<'_, I> {
     }
 }
 
+thread_local! {
+    /// The draw of the polygon this thread last gathered in parts on, keyed by the kernel, the
+    /// polygon and the facing ([`Kernel::polygon_draw`]).
+    static POLYGON_DRAW: RefCell<Option<(PolygonKey, Option<Draw>)>> =
+        const { RefCell::new(None) };
+}
+
+/// A kept polygon draw's key: the kernel's id, the polygon and the facing (its bits).
+type PolygonKey = (u64, u32, [u32; 3]);
+
 impl<I> Kernel<'_, I> {
+    /// The draw of the polygon `spot`'s patch is cut from, facing the patch's way: its cut of
+    /// the emitters' tree for the polygon's bounding sphere ([`super::emitters::Emitters::draw_for`]),
+    /// what every gather in parts on the polygon draws from. The same for every point of the
+    /// polygon, as their random numbers are (`elements` seeds a point's gather by its polygon),
+    /// so two points' values differ by the light, not by the samples: drawn per patch, a
+    /// patch's corner gathered as its neighbour and its own midpoints read different lamps'
+    /// samples, and a uniformly lit furnace was refined for that noise. A polygon's points are
+    /// gathered one after another (the elements' corners, a picture's pixels), so the last
+    /// polygon's draw is kept per thread (a cut per point was 28 % of a generated 100 k-patch
+    /// building's run). A pure function of the kernel, the polygon and the facing, so the
+    /// results do not depend on it.
+    fn polygon_draw(&self, spot: &Spot) -> Option<Draw> {
+        let p = &self.mesh.patches[spot.patch];
+        let key = (p.polygon, p.normal.to_array().map(f32::to_bits));
+        let key = (self.id, key.0, key.1);
+        POLYGON_DRAW.with(|kept| {
+            if let Some((k, draw)) = &*kept.borrow() {
+                if *k == key {
+                    return draw.clone();
+                }
+            }
+            let (centre, radius) =
+                self.polygons.get_or_init(|| polygon_spheres(self.mesh))[p.polygon as usize];
+            let r = Receiver {
+                centre,
+                normal: p.normal,
+                radius,
+            };
+            let draw = self.emitters.draw_for(&r);
+            *kept.borrow_mut() = Some((key, draw.clone()));
+            draw
+        })
+    }
+
     /// The gathers of `patches` (neighbours on one plane, facing one way, gathered next with
     /// `learned`) share the shape of one cut of the emitters' tree ([`Learned::share_cut`]);
     /// a single patch makes its own.
@@ -260,6 +318,29 @@ impl<I> Kernel<'_, I> {
             radius,
         }
     }
+}
+
+/// Per polygon of `mesh` (by id), the centre and half-diagonal of the bounding box of its
+/// patches' corners (a polygon no patch was cut from: the origin, radius 0).
+fn polygon_spheres(mesh: &crate::mesh::Mesh) -> Vec<(Vec3, f32)> {
+    let n = (mesh.patches.iter())
+        .map(|p| p.polygon as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut boxes = vec![(Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)); n];
+    for (i, p) in mesh.patches.iter().enumerate() {
+        let b = &mut boxes[p.polygon as usize];
+        for &v in mesh.patch_indices(i) {
+            let x = mesh.vertices[v as usize];
+            *b = (b.0.min(x), b.1.max(x));
+        }
+    }
+    (boxes.into_iter())
+        .map(|(lo, hi)| match lo.x <= hi.x {
+            true => ((lo + hi) * 0.5, (hi - lo).length() * 0.5),
+            false => (Vec3::ZERO, 0.0),
+        })
+        .collect()
 }
 
 /// The variance of the mean of stratified samples, by collapsing neighbouring strata in

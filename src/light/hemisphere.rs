@@ -192,7 +192,7 @@ impl<I: Intersector> Kernel<'_, I> {
                     emitted = self.emitted_towards(
                         r,
                         (spot.n, dir, t),
-                        &[(&split.draw, 1.0)],
+                        &[(split.weigh.as_ref().unwrap_or(&split.draw), 1.0)],
                         (split.nl, split.nc),
                     );
                 }
@@ -325,7 +325,7 @@ impl<I: Intersector> Kernel<'_, I> {
         if nl > 0.0 {
             let (e, mass) = self.followed_pick(&mix, rng.gen());
             let yj = self.emitters.at[e].points.at(rng.gen(), rng.gen());
-            let (v, j, cast) = self.light_sample(&from, (e, mass), yj, (1.0, 1.0));
+            let (v, j, cast) = self.light_sample(&from, (e, mass, mass), yj, (1.0, 1.0));
             if cast {
                 acc.rays += 1;
                 acc.v += v;

@@ -160,7 +160,16 @@ pub(crate) struct Kernel<'a, I> {
     pub luminaire_channels: Vec<Option<usize>>,
     /// The luminaires' cumulative shares of their flux (`luminaires::flux_cdf`).
     pub luminaire_flux_cdf: Vec<f64>,
+    /// This kernel among all made in the process (the key of `gather`'s per-thread draw of
+    /// the last polygon gathered in parts).
+    pub id: u64,
+    /// Per polygon of the model, the centre and radius of its patches' bounding box (made
+    /// when a gather in parts first asks: `Kernel::polygon_draw`).
+    pub polygons: std::sync::OnceLock<Vec<(Vec3, f32)>>,
 }
+
+/// The next [`Kernel::id`].
+static KERNELS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl<'a, I> Kernel<'a, I> {
     /// The kernel over `mesh` and `isect` reading the solution `sol`, lit by `sky` when there
@@ -196,6 +205,8 @@ impl<'a, I> Kernel<'a, I> {
             eps_floor: reach * 5e-7,
             luminaire_channels,
             luminaire_flux_cdf: luminaires::flux_cdf(&mesh.luminaires),
+            id: KERNELS.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            polygons: std::sync::OnceLock::new(),
         }
     }
 

@@ -320,3 +320,106 @@ fn element_flags_are_checked() {
         assert!(help.contains(flag), "{flag} not in solve --help");
     }
 }
+
+/// In a building of 30 closed rooms, each lit by its own lamp, the split corners' direct light
+/// at a point draws its light samples from what can light the point's patch — its own room's
+/// lamp — not from every lamp by power, which gave the point's own lamp one sample in 30 (of
+/// 24: none, or one weighing 30 times): 24-ray estimates at a floor point agree with a
+/// 4,096-ray one within 10 % (RMS over 40 seeds).
+#[test]
+fn split_direct_light_draws_the_rooms_own_lamp() {
+    use glam::vec3;
+    use radiosity::light::LightParts;
+    use rand::SeedableRng;
+    let mut s = scene_builder::scene(
+        "rooms",
+        vec![
+            scene_builder::material("wall", 0.5, 0.0),
+            scene_builder::material("lamp", 0.0, 5.0),
+        ],
+    );
+    for (i, j) in (0..6).flat_map(|i| (0..5).map(move |j| (i, j))) {
+        let lo = vec3(4.0 * i as f32, 0.0, 4.0 * j as f32);
+        let hi = lo + vec3(3.8, 3.0, 3.8);
+        let c = (lo + hi) * 0.5;
+        let (a, b) = (lo, hi);
+        let faces = [
+            [
+                vec3(a.x, a.y, a.z),
+                vec3(b.x, a.y, a.z),
+                vec3(b.x, a.y, b.z),
+                vec3(a.x, a.y, b.z),
+            ],
+            [
+                vec3(a.x, b.y, a.z),
+                vec3(b.x, b.y, a.z),
+                vec3(b.x, b.y, b.z),
+                vec3(a.x, b.y, b.z),
+            ],
+            [
+                vec3(a.x, a.y, a.z),
+                vec3(b.x, a.y, a.z),
+                vec3(b.x, b.y, a.z),
+                vec3(a.x, b.y, a.z),
+            ],
+            [
+                vec3(a.x, a.y, b.z),
+                vec3(b.x, a.y, b.z),
+                vec3(b.x, b.y, b.z),
+                vec3(a.x, b.y, b.z),
+            ],
+            [
+                vec3(a.x, a.y, a.z),
+                vec3(a.x, b.y, a.z),
+                vec3(a.x, b.y, b.z),
+                vec3(a.x, a.y, b.z),
+            ],
+            [
+                vec3(b.x, a.y, a.z),
+                vec3(b.x, b.y, a.z),
+                vec3(b.x, b.y, b.z),
+                vec3(b.x, a.y, b.z),
+            ],
+        ];
+        for f in faces {
+            let centre = (f[0] + f[1] + f[2] + f[3]) * 0.25;
+            scene_builder::polygon_facing(&mut s, &f, c - centre, 0);
+        }
+        let y = hi.y - 0.01;
+        let lamp = [
+            vec3(c.x - 0.3, y, c.z - 0.3),
+            vec3(c.x + 0.3, y, c.z - 0.3),
+            vec3(c.x + 0.3, y, c.z + 0.3),
+            vec3(c.x - 0.3, y, c.z + 0.3),
+        ];
+        scene_builder::polygon_facing(&mut s, &lamp, vec3(0.0, -1.0, 0.0), 1);
+    }
+    let m = scene_builder::mesh_at(&s, Some(1.0));
+    let isect = EmbreeScene::build(&m, |_| true).unwrap();
+    let sol = solve::solve(&m, &s.materials, &isect, &SolveSettings::default(), |_| {}).unwrap();
+    let light = LightAt::new(&m, &s.materials, &isect, &sol.b, None, None);
+    // The floor patch of room (2, 2) nearest the point below its lamp, 0.3 m off its centre.
+    let x = vec3(10.2, 0.0, 9.6);
+    let (patch, _) = (m.patches.iter().enumerate())
+        .filter(|(_, p)| p.normal.y > 0.9 && p.centre.y < 0.01)
+        .map(|(i, p)| (i, p.centre.distance(x)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap();
+    let at = [m.patches[patch].centre + vec3(0.0, 1e-4, 0.0)];
+    let direct = |rays: usize, seed: u64| {
+        let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+        let (b, _, _) = light.part_at(patch, &at, rays, LightParts::Direct, &mut rng);
+        (b.x + b.y + b.z) / 3.0
+    };
+    let reference = direct(4096, 1);
+    assert!(reference > 0.0, "{reference}");
+    let rms = ((0..40u64)
+        .map(|k| (direct(24, 100 + k) / reference - 1.0).powi(2))
+        .sum::<f64>()
+        / 40.0)
+        .sqrt();
+    assert!(
+        rms < 0.1,
+        "24-ray direct light off by {rms} (RMS, relative)"
+    );
+}
