@@ -105,7 +105,7 @@ pub(super) struct Split {
     pub follow: u32,
     /// What the MIS weights between the light samples and the hemisphere rays take for the
     /// light samples' density, when not `draw`'s own: a gather split in parts samples its
-    /// patch's cut but weighs by power, so that the weights of a path still add up to one
+    /// polygon's cut but weighs by power, so that the weights of a path still add up to one
     /// wherever its two parts are gathered (any weights that do are unbiased; by power they
     /// are the same at every point, and so is what each part holds in expectation).
     pub weigh: Option<Draw>,
