@@ -35,6 +35,7 @@
 
 mod learn;
 mod sight;
+mod whole;
 
 use super::{scalar, Rgb};
 use crate::mesh::spatial::{facing_class, space_order};
@@ -43,6 +44,7 @@ use crate::sample::PatchPoints;
 use glam::Vec3;
 pub(crate) use learn::Learned;
 pub(crate) use sight::Sight;
+pub(crate) use whole::{Shape, WholeSet, WHOLE_MASS, WHOLE_MOST};
 
 /// At most this many nodes of the emitters' tree in a receiver's cut (each emitting patch is
 /// its own node of the cut when there are no more emitting patches than this).

@@ -4,7 +4,7 @@
 //! rays shared out between them and their estimates combined by multiple importance sampling
 //! (see the module notes of [`super`]); with the variance of its mean, from the strata.
 
-use super::emitters::{Draw, Learned, Receiver};
+use super::emitters::{Draw, Learned, Receiver, WholeSet};
 use super::{Kernel, Origin, Rgb};
 use crate::intersect::Intersector;
 use crate::sample::polar::PolarGrid;
@@ -32,17 +32,31 @@ pub enum LightParts {
     /// has set, and each step followed is a path of one light sample and one ray, the noisiest
     /// and costliest part of a node (docs/results/adaptive-elements.md).
     IndirectOnce,
+    /// `Direct`, the emitters the surface's polygon draws most taken whole: their unoccluded
+    /// irradiance in closed form times what the shadow rays find unblocked ([`super::exact`]),
+    /// the rest by light samples; with `IndirectOnce`, whose hemisphere rays leave those
+    /// emitters out, the adaptive elements' split of the light at a point of a patch.
+    DirectWhole,
 }
 
 impl LightParts {
     /// Whether the emitters' and the sun's light samples (and a patch's own emission) are in.
     pub fn direct(self) -> bool {
-        matches!(self, LightParts::All | LightParts::Direct)
+        matches!(
+            self,
+            LightParts::All | LightParts::Direct | LightParts::DirectWhole
+        )
     }
 
     /// Whether the hemisphere rays are cast.
     pub fn hemisphere(self) -> bool {
-        self != LightParts::Direct
+        !matches!(self, LightParts::Direct | LightParts::DirectWhole)
+    }
+
+    /// Whether the polygon's whole emitters ([`super::exact`]) are set apart: taken whole by
+    /// `DirectWhole`, left out by `IndirectOnce`.
+    fn sets_whole_apart(self) -> bool {
+        matches!(self, LightParts::DirectWhole | LightParts::IndirectOnce)
     }
 }
 
@@ -109,11 +123,20 @@ pub(super) struct Split {
     /// wherever its two parts are gathered (any weights that do are unbiased; by power they
     /// are the same at every point, and so is what each part holds in expectation).
     pub weigh: Option<Draw>,
+    /// The emitters taken whole (indices into the emitters, ascending; [`super::exact`]):
+    /// their light is `DirectWhole`'s alone, and `IndirectOnce`'s hemisphere rays leave it
+    /// out. Empty for the other parts.
+    pub whole: WholeSet,
 }
 
 impl Split {
     /// `rays_wanted` rays for `parts`, with emitters to sample (`lamps`) and a `sun` or not.
-    fn new(parts: LightParts, draw: Option<Draw>, sun: bool, rays_wanted: usize) -> Split {
+    fn new(
+        parts: LightParts,
+        (draw, whole): (Option<Draw>, WholeSet),
+        sun: bool,
+        rays_wanted: usize,
+    ) -> Split {
         let lamps = draw.is_some();
         let (direct, n_sun) = match (parts, lamps, sun) {
             (LightParts::Indirect | LightParts::IndirectOnce, _, _) => (0, 0),
@@ -122,13 +145,13 @@ impl Split {
                 if s { (rays_wanted / 4).max(1) } else { 0 },
             ),
             // All the rays to the lights: two thirds to the emitters when there is a sun too.
-            (LightParts::Direct, true, true) => {
+            (LightParts::Direct | LightParts::DirectWhole, true, true) => {
                 let d = (rays_wanted * 2 / 3).max(1);
                 (d, rays_wanted.saturating_sub(d).max(1))
             }
-            (LightParts::Direct, true, false) => (rays_wanted.max(1), 0),
-            (LightParts::Direct, false, true) => (0, rays_wanted.max(1)),
-            (LightParts::Direct, false, false) => (0, 0),
+            (LightParts::Direct | LightParts::DirectWhole, true, false) => (rays_wanted.max(1), 0),
+            (LightParts::Direct | LightParts::DirectWhole, false, true) => (0, rays_wanted.max(1)),
+            (LightParts::Direct | LightParts::DirectWhole, false, false) => (0, 0),
         };
         let grid = PolarGrid::for_samples(rays_wanted.saturating_sub(direct + n_sun).max(2) as f64);
         // The MIS weights (power heuristic, by the counts of light and hemisphere samples).
@@ -149,6 +172,7 @@ impl Split {
             nl,
             nc,
             weigh: (parts != LightParts::All && lamps).then(Draw::by_power),
+            whole,
             follow: if parts == LightParts::IndirectOnce {
                 1
             } else {
@@ -188,12 +212,19 @@ impl<I: Intersector> Kernel<'_, I> {
         // drawn by power over the whole model, most of a point's light samples went to other
         // rooms' lamps. What earlier gathers learnt (`learned`) only shapes a whole gather's.
         // A point in the air split in parts draws by power.
+        let mut whole = WholeSet::default();
         let draw = match (lamps, ask.parts) {
             (false, _) => None,
             (true, parts) if parts != LightParts::All && spot.patch == super::NO_PATCH => {
                 Some(Draw::by_power())
             }
-            (true, parts) if parts != LightParts::All => self.polygon_draw(spot),
+            (true, parts) if parts != LightParts::All => {
+                let (draw, w) = self.polygon_draw(spot);
+                if parts.sets_whole_apart() {
+                    whole = w;
+                }
+                draw
+            }
             (true, _) => {
                 let r = self.receiver(spot);
                 let l = learned.as_deref();
@@ -213,8 +244,10 @@ impl<I: Intersector> Kernel<'_, I> {
             }
         };
         let sun = self.sky.sun();
-        let split = Split::new(ask.parts, draw, sun.is_some(), ask.rays);
-        if split.direct > 0 {
+        let split = Split::new(ask.parts, (draw, whole), sun.is_some(), ask.rays);
+        if split.direct > 0 && ask.parts == LightParts::DirectWhole {
+            self.whole_direct_part(spot, &split, &mut g, rng);
+        } else if split.direct > 0 {
             self.direct_part(spot, &split, &mut g, learned.as_deref_mut(), rng);
         }
         if let Some(sun) = sun.filter(|_| split.sun > 0) {
@@ -236,9 +269,12 @@ impl<I: Intersector> Kernel<'_, I> {
 thread_local! {
     /// The draw of the polygon this thread last gathered in parts on, keyed by the kernel, the
     /// polygon and the facing ([`Kernel::polygon_draw`]).
-    static POLYGON_DRAW: RefCell<Option<(PolygonKey, Option<Draw>)>> =
+    static POLYGON_DRAW: RefCell<Option<(PolygonKey, PolygonDraw)>> =
         const { RefCell::new(None) };
 }
+
+/// A polygon's draw, and the emitters it takes whole ([`super::exact`]).
+type PolygonDraw = (Option<Draw>, WholeSet);
 
 /// A kept polygon draw's key: the kernel's id, the polygon and the facing (its bits).
 type PolygonKey = (u64, u32, [u32; 3]);
@@ -254,8 +290,9 @@ impl<I> Kernel<'_, I> {
     /// gathered one after another (the elements' corners, a picture's pixels), so the last
     /// polygon's draw is kept per thread (a cut per point was 28 % of a generated 100 k-patch
     /// building's run). A pure function of the kernel, the polygon and the facing, so the
-    /// results do not depend on it.
-    fn polygon_draw(&self, spot: &Spot) -> Option<Draw> {
+    /// results do not depend on it. With the draw, the emitters it takes whole
+    /// ([`super::emitters::WHOLE_MASS`]).
+    fn polygon_draw(&self, spot: &Spot) -> PolygonDraw {
         let p = &self.mesh.patches[spot.patch];
         let key = (p.polygon, p.normal.to_array().map(f32::to_bits));
         let key = (self.id, key.0, key.1);
@@ -273,8 +310,13 @@ impl<I> Kernel<'_, I> {
                 radius,
             };
             let draw = self.emitters.draw_for(&r);
-            *kept.borrow_mut() = Some((key, draw.clone()));
-            draw
+            let whole = draw.as_ref().map_or_else(WholeSet::default, |d| {
+                use super::emitters::{WHOLE_MASS, WHOLE_MOST};
+                self.emitters.whole(self.mesh, d, WHOLE_MASS, WHOLE_MOST)
+            });
+            let out = (draw, whole);
+            *kept.borrow_mut() = Some((key, out.clone()));
+            out
         })
     }
 

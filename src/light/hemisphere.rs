@@ -188,7 +188,10 @@ impl<I: Intersector> Kernel<'_, I> {
             let mut emitted = Rgb::ZERO;
             let mut sub = Reflected::default();
             if let Some((r, t)) = recv {
-                if split.nl > 0.0 {
+                // An emitter taken whole is the direct part's alone (`exact`).
+                let whole = !split.whole.ids.is_empty()
+                    && (self.emitters.index_of(r)).is_some_and(|e| split.whole.has(e));
+                if split.nl > 0.0 && !whole {
                     emitted = self.emitted_towards(
                         r,
                         (spot.n, dir, t),

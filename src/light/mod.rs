@@ -54,6 +54,7 @@
 pub mod coefficients;
 pub mod direct;
 pub mod emitters;
+pub mod exact;
 pub mod gather;
 pub mod hemisphere;
 pub mod light_at;
