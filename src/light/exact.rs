@@ -198,8 +198,8 @@ impl<I: Intersector> Kernel<'_, I> {
 
     /// `count` shadow rays from `from` to the whole faces of the units `which` picks, drawn in
     /// proportion to their unoccluded light (stratified), a member of the face by its area and
-    /// a point uniform on it: what each ray finds, over its density, is
-    /// added to its unit's books.
+    /// a point uniform on it: what each ray finds, over its density, is added to its unit's
+    /// books.
     fn shadow_stage<R: Rng>(
         &self,
         (from, shapes): (&Origin, &[Shape]),

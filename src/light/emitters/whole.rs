@@ -13,6 +13,7 @@ pub const WHOLE_MASS: f64 = 1.0 / 64.0;
 /// At most this many emitters are taken whole per surface (each costs its closed form at
 /// every point).
 pub const WHOLE_MOST: usize = 32;
+
 /// The emitters a surface takes whole and the probability its draw gives them together.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct WholeSet {
@@ -33,7 +34,7 @@ pub(crate) struct Shape {
     pub areas: Vec<f64>,
     /// The outline's edges, wound as the patches are.
     pub outline: Vec<[DVec3; 2]>,
-    /// Every member's corners, and where each member's begin.
+    /// Every member's corners, and where each member's corners begin.
     pub corners: Vec<DVec3>,
     pub first: Vec<usize>,
     /// The emitting side's normal, and the exitance every member shares.
