@@ -10,9 +10,11 @@ use crate::intersect::{Intersector, Ray};
 use glam::Vec3;
 use rand::Rng;
 
-/// A shadow ray's outcome: E_j·cosθ_i·cosθ_j/(π r²) (0 when not seen) and its geometry.
+/// A shadow ray's outcome: E_j·cosθ_i·cosθ_j/(π r²) (0 when not seen), the same with nothing
+/// in between (`open`), and its geometry.
 pub(super) struct Shadow {
     pub e_g: Rgb,
+    pub open: Rgb,
     pub cos_i: f64,
     pub cos_j: f64,
     pub dist: f64,
@@ -56,6 +58,9 @@ impl<I: Intersector> Kernel<'_, I> {
                 self.mesh.receiver(h.patch, h.back) == Some(j as u32) || h.t >= dist * (1.0 - 1e-4)
             }
         };
+        let open =
+            f64::from(cos_i) * f64::from(cos_j) / (std::f64::consts::PI * f64::from(dist).powi(2));
+        // Written as it always was, so that a glazed path rounds as before.
         let g = if seen {
             traced.through * f64::from(cos_i) * f64::from(cos_j)
                 / (std::f64::consts::PI * f64::from(dist).powi(2))
@@ -64,6 +69,7 @@ impl<I: Intersector> Kernel<'_, I> {
         };
         Some(Shadow {
             e_g: em.e * g,
+            open: em.e * open,
             cos_i: f64::from(cos_i),
             cos_j: f64::from(cos_j),
             dist: f64::from(dist),

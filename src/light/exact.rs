@@ -243,7 +243,7 @@ impl<I: Intersector> Kernel<'_, I> {
             g.rays += 1;
             // ÷ the density: the face's share of the stage's light, over its area.
             let scale = area * total / scalar(at.open);
-            let open = em.e * (sh.cos_i * sh.cos_j / (std::f64::consts::PI * sh.dist * sh.dist));
+            let open = sh.open;
             let u = &mut units[at.unit];
             u.lit &= scalar(sh.e_g) >= scalar(open) * (1.0 - 1e-9);
             u.dark &= scalar(sh.e_g) <= 0.0;

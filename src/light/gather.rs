@@ -219,10 +219,8 @@ impl<I: Intersector> Kernel<'_, I> {
                 Some(Draw::by_power())
             }
             (true, parts) if parts != LightParts::All => {
-                let (draw, w) = self.polygon_draw(spot);
-                if parts.sets_whole_apart() {
-                    whole = w;
-                }
+                let (draw, w) = self.polygon_draw(spot, parts.sets_whole_apart());
+                whole = w;
                 draw
             }
             (true, _) => {
@@ -273,8 +271,8 @@ thread_local! {
         const { RefCell::new(None) };
 }
 
-/// A polygon's draw, and the emitters it takes whole ([`super::exact`]).
-type PolygonDraw = (Option<Draw>, WholeSet);
+/// A polygon's draw, and the emitters it takes whole ([`super::exact`]) once a gather asked.
+type PolygonDraw = (Option<Draw>, Option<WholeSet>);
 
 /// A kept polygon draw's key: the kernel's id, the polygon and the facing (its bits).
 type PolygonKey = (u64, u32, [u32; 3]);
@@ -290,33 +288,35 @@ impl<I> Kernel<'_, I> {
     /// gathered one after another (the elements' corners, a picture's pixels), so the last
     /// polygon's draw is kept per thread (a cut per point was 28 % of a generated 100 k-patch
     /// building's run). A pure function of the kernel, the polygon and the facing, so the
-    /// results do not depend on it. With the draw, the emitters it takes whole
-    /// ([`super::emitters::WHOLE_MASS`]).
-    fn polygon_draw(&self, spot: &Spot) -> PolygonDraw {
+    /// results do not depend on it. With the draw, when `whole` asks, the emitters it takes
+    /// whole ([`super::emitters::WHOLE_MASS`]; made once per polygon, and only then).
+    fn polygon_draw(&self, spot: &Spot, whole: bool) -> (Option<Draw>, WholeSet) {
         let p = &self.mesh.patches[spot.patch];
         let key = (p.polygon, p.normal.to_array().map(f32::to_bits));
         let key = (self.id, key.0, key.1);
         POLYGON_DRAW.with(|kept| {
-            if let Some((k, draw)) = &*kept.borrow() {
-                if *k == key {
-                    return draw.clone();
-                }
+            let mut kept = kept.borrow_mut();
+            if kept.as_ref().is_none_or(|(k, _)| *k != key) {
+                let (centre, radius) =
+                    self.polygons.get_or_init(|| polygon_spheres(self.mesh))[p.polygon as usize];
+                let r = Receiver {
+                    centre,
+                    normal: p.normal,
+                    radius,
+                };
+                *kept = Some((key, (self.emitters.draw_for(&r), None)));
             }
-            let (centre, radius) =
-                self.polygons.get_or_init(|| polygon_spheres(self.mesh))[p.polygon as usize];
-            let r = Receiver {
-                centre,
-                normal: p.normal,
-                radius,
-            };
-            let draw = self.emitters.draw_for(&r);
-            let whole = draw.as_ref().map_or_else(WholeSet::default, |d| {
-                use super::emitters::{WHOLE_MASS, WHOLE_MOST};
-                self.emitters.whole(self.mesh, d, WHOLE_MASS, WHOLE_MOST)
+            let (_, (draw, taken)) = kept.as_mut().expect("kept above");
+            if !whole {
+                return (draw.clone(), WholeSet::default());
+            }
+            let taken = taken.get_or_insert_with(|| {
+                draw.as_ref().map_or_else(WholeSet::default, |d| {
+                    use super::emitters::{WHOLE_MASS, WHOLE_MOST};
+                    self.emitters.whole(self.mesh, d, WHOLE_MASS, WHOLE_MOST)
+                })
             });
-            let out = (draw, whole);
-            *kept.borrow_mut() = Some((key, out.clone()));
-            out
+            (draw.clone(), taken.clone())
         })
     }
 
