@@ -60,14 +60,17 @@ impl LightParts {
     }
 }
 
-/// One gather: irradiance H (RGB), per light channel, the scalar variance of ρ·H's mean, and
-/// the rays it cast.
+/// One gather: irradiance H (RGB), per light channel, the scalar variance of ρ·H's mean, the
+/// rays it cast, and of H the irradiance its hemisphere rays found reflected by other surfaces
+/// (not emitted, not the sky's): how the light still to be shot will arrive
+/// (`solve::final_gather`, "The light still owed").
 #[derive(Clone, Debug)]
 pub(crate) struct Gathered {
     pub h: Rgb,
     pub ch: Vec<Rgb>,
     pub var: f64,
     pub rays: u64,
+    pub reflected: Rgb,
 }
 
 /// Where a gather is made: the points `at(u, v)` of the unit square's map (a patch's, or one
@@ -204,6 +207,7 @@ impl<I: Intersector> Kernel<'_, I> {
             ch: vec![Rgb::ZERO; self.sol.channels.len()],
             var: 0.0,
             rays: 0,
+            reflected: Rgb::ZERO,
         };
         let lamps = !self.emitters.is_empty() && ask.lights;
         // A gather draws its emitters by what they can give its spot (none: no light samples

@@ -172,7 +172,7 @@ impl<I: Intersector> Kernel<'_, I> {
         let frame = Frame::new(spot.n, angle);
         let here = latin(x_count, false, rng);
         let mut m = Vec::with_capacity(x_count);
-        let mut sum = Rgb::ZERO;
+        let (mut sum, mut reflected) = (Rgb::ZERO, Rgb::ZERO);
         for (cell, &(u, v)) in here.iter().enumerate() {
             let dir = frame.to_world(split.grid.direction(cell, 0.0, true, rng));
             let org = spot.origin(u, v).x;
@@ -209,6 +209,7 @@ impl<I: Intersector> Kernel<'_, I> {
             m.push(scalar(spot.rho * val));
             sum += val;
             if let Some((r, _)) = recv {
+                reflected += seen.through * sub.v;
                 for (c, chc) in g.ch.iter_mut().enumerate() {
                     let lit = if self.sol.own(r, c) {
                         emitted
@@ -223,6 +224,7 @@ impl<I: Intersector> Kernel<'_, I> {
             }
         }
         g.h += sum / x_count as f64;
+        g.reflected += reflected / x_count as f64;
         g.var += stratified_var(&m);
     }
 

@@ -7,8 +7,8 @@
 //! - average weighted percent error = (1/n) Σ_i |B_i − B_i^ref| / B_i^ref;
 //! - and the RMS relative error sqrt((1/n) Σ_i ((B_i − B_i^ref)/B_i^ref)²).
 //!
-//! Patches whose reference radiosity is zero (black, unlit) carry no relative error and are left
-//! out of n.
+//! Patches whose reference radiosity is zero (black, unlit), or a numerical zero
+//! ([`BLACK_SHARE`]), carry no relative error and are left out of n.
 //!
 //! **The estimate** ([`Estimator`]) adds, per patch, the two things a progressive solve gets
 //! wrong, and puts the sum through the same metrics:
@@ -40,13 +40,31 @@ pub struct ErrorMetrics {
     pub rms_relative: f64,
 }
 
+/// A patch whose radiosity is at most this share of the area-weighted mean is black for the
+/// relative metrics (as a zero is): forty stops below the mean no meter or display reads it,
+/// and a solve's "nearly nothing" there (1e-35 W/m² on a face no light reaches, what a
+/// combination of weights leaves) is a numerical zero whose relative error means nothing.
+pub const BLACK_SHARE: f64 = 1e-12;
+
+/// The radiosity at or below which a patch of `b` (scalar, W/m²) counts as black
+/// ([`BLACK_SHARE`] of the area-weighted mean).
+pub fn black_floor(area: &[f64], b: &[f64]) -> f64 {
+    let (sum, total) = (area.iter().zip(b)).fold((0.0, 0.0), |(s, t), (&a, &r)| (s + r * a, t + a));
+    if total > 0.0 {
+        BLACK_SHARE * sum / total
+    } else {
+        0.0
+    }
+}
+
 /// Metrics from per-patch absolute errors `err` (scalar W/m²) against radiosities `b_ref`.
 pub fn from_errors(area: &[f64], err: impl Iterator<Item = f64>, b_ref: &[f64]) -> ErrorMetrics {
     let (mut energy, mut total, mut pct, mut sq, mut n) = (0.0, 0.0, 0.0, 0.0, 0usize);
+    let black = black_floor(area, b_ref);
     for ((&a, e), &r) in area.iter().zip(err).zip(b_ref) {
         energy += e * a;
         total += r * a;
-        if r > 0.0 {
+        if r > black {
             let rel = e / r;
             pct += rel;
             sq += rel * rel;
@@ -288,6 +306,12 @@ mod tests {
     fn black_patches_are_left_out_of_the_relative_metrics() {
         let m = against(&[1.0, 1.0], &[[1.1; 3], [0.2; 3]], &[[1.0; 3], [0.0; 3]]);
         assert!((m.weighted_percent - 0.1).abs() < 1e-9);
+        // A numerical zero (1e-35 W/m² beside 1 W/m²) is black too, whatever its error.
+        let m = from_errors(&[1.0, 1.0], [0.1, 1e-17].into_iter(), &[1.0, 1e-35]);
+        assert!((m.weighted_percent - 0.1).abs() < 1e-9, "{m:?}");
+        // Faint but real light (1e-9 of the mean) is counted.
+        let m = from_errors(&[1.0, 1.0], [0.1, 1e-10].into_iter(), &[1.0, 1e-9]);
+        assert!((m.weighted_percent - 0.1).abs() < 1e-9, "{m:?}");
     }
 
     #[test]

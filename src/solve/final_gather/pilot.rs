@@ -23,8 +23,8 @@
 //! The choice depends on the model and the seed only, not on the threads.
 
 use super::{
-    first_round, gather_runs, pooled, weigh, GatherInputs, Gathered, Gathers, PatchModel, Solution,
-    LEARNING_RUN,
+    blacken, first_round, gather_runs, owed_per_reflected, pooled, weigh, GatherInputs, Gathered,
+    Gathers, PatchModel, Solution, LEARNING_RUN,
 };
 use crate::intersect::Intersector;
 use crate::light::Kernel;
@@ -153,19 +153,32 @@ fn choose_rays<I: Intersector>(
 ) -> (usize, f64) {
     let mesh = kernel.mesh;
     let light = (&kernel.sol.e[..], &kernel.sol.rho[..]);
-    let model: Vec<PatchModel> = (sample.iter().zip(first))
-        .map(|(&i, g)| weigh(inp.shooting, &sol.b, light, mesh.patches[i].area, (i, g)).model)
+    let area = |i: usize| mesh.patches[i].area;
+    let owed = owed_per_reflected(
+        inp.shooting,
+        light.1,
+        area,
+        sample.iter().copied().zip(first),
+    );
+    let mut model: Vec<PatchModel> = (sample.iter().zip(first))
+        .map(|(&i, g)| weigh(inp.shooting, &sol.b, light, (area(i), owed), (i, g)).model)
         .collect();
-    // The patches not gathered keep the shooting's error.
+    // The patches not gathered keep the shooting's error; the black floor is the shooting's.
     let parts = &inp.shooting.parts;
+    let b_true: Vec<f64> = (sol.b.iter().zip(&parts.missing))
+        .map(|(b, m)| scalar(b) + m)
+        .collect();
+    let areas: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
+    let black = estimate::black_floor(&areas, &b_true);
+    blacken(&mut model, black);
     let mut in_todo = vec![false; mesh.patches.len()];
     for &i in todo {
         in_todo[i] = true;
     }
     let (mut fixed, mut count) = (0.0, 0.0);
     for i in (0..mesh.patches.len()).filter(|&i| !in_todo[i]) {
-        let b_true = scalar(&sol.b[i]) + parts.missing[i];
-        if b_true > 0.0 {
+        let b_true = b_true[i];
+        if b_true > black {
             fixed += estimate::combine(parts.missing[i], parts.sigma[i]) / b_true;
             count += 1.0;
         }
