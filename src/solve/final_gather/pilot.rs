@@ -153,7 +153,8 @@ fn choose_rays<I: Intersector>(
 ) -> (usize, f64) {
     let mesh = kernel.mesh;
     let light = (&kernel.sol.e[..], &kernel.sol.rho[..]);
-    let area = |i: usize| mesh.patches[i].area;
+    let areas: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
+    let area = |i: usize| areas[i];
     let owed = owed_per_reflected(
         inp.shooting,
         light.1,
@@ -168,7 +169,6 @@ fn choose_rays<I: Intersector>(
     let b_true: Vec<f64> = (sol.b.iter().zip(&parts.missing))
         .map(|(b, m)| scalar(b) + m)
         .collect();
-    let areas: Vec<f64> = mesh.patches.iter().map(|p| p.area).collect();
     let black = estimate::black_floor(&areas, &b_true);
     blacken(&mut model, black);
     let mut in_todo = vec![false; mesh.patches.len()];
