@@ -147,8 +147,8 @@ fn gather_points(
     let (rays, gathered) = gather_new(
         &mut values.indirect,
         (patches.len(), |k| patches[k]),
-        (|i| list(i, &work[i]), |_, p| p),
-        |i, x| {
+        (|i| list(i, &work[i]), |_, p| p, |_| false),
+        |_, i, _, x| {
             let (b, var, n) = indirect(i, x);
             ((b, var), n)
         },

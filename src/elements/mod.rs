@@ -24,6 +24,7 @@
 pub mod display;
 pub mod geometry;
 mod indirect;
+mod points;
 pub mod refine;
 mod work;
 

@@ -34,6 +34,18 @@
 //! position, facing and material, once for the patches along that edge that have it (the
 //! display welds them into one vertex anyway, and the insets differ by 0.2 % of a patch).
 //!
+//! **Told by the corners.** A point's direct light is the closed form of each whole lamp face
+//! times what its shadow rays find unblocked (`light::exact`); where every ray of a face
+//! arrived, or none did, the gather says so ([`Vis`]). A level gathers its elements' corners
+//! first, then the points between them: an edge's midpoint takes as seen (or hidden) the faces
+//! both ends of its edge saw whole (or not at all), a quad's centre those all four corners
+//! did, and casts rays only to the rest — in a room most points see their lamps whole, so a
+//! midpoint there costs the closed form and no ray. A shadow smaller than an element that
+//! falls between its corners is then missed where the midpoint's own rays might have met it
+//! (a third of them, eight at the default, might not either); measured with `bench elements`
+//! (docs/results/adaptive-elements.md): the same error on `scenes/spot.obj` for 16 % fewer
+//! rays. Only points of the same polygon tell each other (the faces are numbered per polygon).
+//!
 //! **Common random numbers.** Every point of one scene polygon is gathered with a generator
 //! seeded alike, from (seed, [`Stream::Elements`], polygon): neighbouring corners then use the
 //! same directions and light samples, so the difference between two corners — what the
@@ -47,12 +59,12 @@
 
 use super::geometry::{Cut, Elem, Root};
 pub(super) use super::work::{facing, inner_edges, key, At, PatchWork, Values};
-use super::work::{gather_new, on_edges};
+use super::work::{on_edges, NO_PARENTS};
 use super::NOISE_Z;
 use crate::intersect::Intersector;
 use crate::light::{LightAt, LightParts};
 use crate::mesh::Mesh;
-use crate::solve::{rng_for, scalar, Stream};
+use crate::solve::scalar;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
@@ -187,7 +199,7 @@ impl Stop<'_> {
 
 /// The points a decision on `e` reads: its corners and, unless the test is on the corners
 /// alone, the points a cut would add (edge midpoints, a quad's centre).
-fn test_points(e: &Elem, test: Test) -> Vec<DVec2> {
+pub(super) fn test_points(e: &Elem, test: Test) -> Vec<DVec2> {
     let uv = e.corners_uv();
     let mut pts = uv.to_vec();
     if test != Test::Corners {
@@ -247,7 +259,7 @@ impl<I: Intersector> Refiner<'_, I> {
     /// The value of a point gathered earlier (0 if it was not: a refinement stopped early).
     fn value(&self, patch: usize, w: &PatchWork, root: u32, uv: DVec2, v: &Values) -> [f64; 3] {
         let (at, _) = self.at(patch, w, root, uv);
-        let b = v.map.get(&at).copied().unwrap_or([0.0; 3]);
+        let b = v.map.get(&at).map_or([0.0; 3], |d| d.b);
         // Split corners' gathered indirect light is at the nodes; Full's is in `b`.
         if self.light != CornerLight::Split || !self.near[patch] {
             return b;
@@ -266,56 +278,6 @@ impl<I: Intersector> Refiner<'_, I> {
         super::indirect::var_at(&w.ind_nodes[root as usize], uv)
     }
 
-    /// Gathers at `x`, as patch `patch` (module notes): the direct light, or all of it.
-    fn gather_one(&self, patch: usize, x: DVec3) -> ([f64; 3], f64, u64) {
-        match self.light {
-            CornerLight::Full => self.gather_part(patch, x, LightParts::All, self.rays),
-            CornerLight::Direct | CornerLight::Split => {
-                self.gather_part(patch, x, LightParts::DirectWhole, self.rays)
-            }
-        }
-    }
-
-    /// Gathers `parts` of the light at `x` with `rays` rays, as patch `patch`.
-    pub(super) fn gather_part(
-        &self,
-        patch: usize,
-        x: DVec3,
-        parts: LightParts,
-        rays: usize,
-    ) -> ([f64; 3], f64, u64) {
-        let polygon = self.mesh.patches[patch].polygon as u64;
-        let mut rng = rng_for(self.seed, Stream::Elements, polygon);
-        let pts = [x.as_vec3()];
-        let (b, var, rays) = self.gather.part_at(patch, &pts, rays, parts, &mut rng);
-        let b = b
-            .to_array()
-            .map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
-        (b, var, rays)
-    }
-
-    /// Gathers the points `want` lists for each patch (the points' parameters, by root) that
-    /// `values` does not hold yet: each new one once, by the lowest-numbered patch asking, in
-    /// parallel ([`gather_new`]).
-    fn gather_all(
-        &self,
-        work: &[PatchWork],
-        want: impl Fn(&PatchWork) -> Vec<(u32, DVec2)> + Sync + Send,
-        values: &mut Values,
-    ) {
-        let list = |i: usize| want(&work[i]);
-        let locate = |i: usize, (root, uv)| self.at(i, &work[i], root, uv);
-        let gather = |i, x| {
-            let (b, _, rays) = self.gather_one(i, x);
-            (b, rays)
-        };
-        let patches = (work.len(), |k| k);
-        let (rays, gathered) =
-            gather_new(&mut values.map, patches, (list, locate), gather, [0.0; 3]);
-        values.rays += rays;
-        values.gathered += gathered;
-    }
-
     /// Forgets the centres of the quads this level kept (`done` from `decided_from`): a kept
     /// element is never cut again and nothing else of its patch lies inside it, so nothing
     /// reads them again (but a doubled face of the same facing and material, which would
@@ -330,17 +292,6 @@ impl<I: Intersector> Refiner<'_, I> {
         for at in &gone {
             values.map.remove(at);
         }
-    }
-
-    /// The points patch `patch`'s active elements need for `rule`'s decisions.
-    fn wanted(&self, w: &PatchWork, rule: Rule) -> Vec<(u32, DVec2)> {
-        let Rule::Adaptive { min_size, test, .. } = rule else {
-            return Vec::new();
-        };
-        (w.active.iter())
-            .filter(|e| big_enough(e, w, min_size))
-            .flat_map(|e| test_points(e, test).into_iter().map(|uv| (e.root, uv)))
-            .collect()
     }
 
     /// The scalar values at `e`'s corners.
@@ -517,7 +468,7 @@ impl<I: Intersector> Refiner<'_, I> {
 }
 
 /// Whether `e` is at least twice the smallest element edge along its longer side.
-fn big_enough(e: &Elem, w: &PatchWork, min_size: f64) -> bool {
+pub(super) fn big_enough(e: &Elem, w: &PatchWork, min_size: f64) -> bool {
     let (along_u, along_v) = e.extents(&w.roots);
     along_u.max(along_v) >= 2.0 * min_size * (1.0 - 1e-6)
 }
@@ -561,7 +512,11 @@ pub(super) fn finish<I: Intersector>(
 ) {
     let corners = |w: &PatchWork| {
         (w.done.iter())
-            .flat_map(|e| e.corners_uv().iter().map(move |&uv| (e.root, uv)))
+            .flat_map(|e| {
+                e.corners_uv()
+                    .iter()
+                    .map(move |&uv| (e.root, uv, NO_PARENTS))
+            })
             .collect()
     };
     r.gather_all(work, corners, values);
@@ -573,7 +528,7 @@ pub(super) fn finish<I: Intersector>(
                 .flat_map(|e| {
                     e.corners_uv().iter().map(move |&uv| {
                         let (at, _) = r.at(i, w, e.root, uv);
-                        v.map.get(&at).copied().unwrap_or([0.0; 3])
+                        v.map.get(&at).map_or([0.0; 3], |d| d.b)
                     })
                 })
                 .collect()

@@ -5,6 +5,7 @@
 //! the display ([`super::display`]).
 
 use super::geometry::{Elem, Root};
+use crate::light::Vis;
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
@@ -15,10 +16,29 @@ use std::collections::{HashMap, HashSet};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(super) struct At(pub [i64; 3], pub [i32; 3], pub u32);
 
+/// A point's gathered light (its direct light, or all of it under
+/// [`super::CornerLight::Full`]) and what its shadow rays told of its polygon's whole faces
+/// (read by the points between it and its neighbours: `super::refine`, "Told by the corners").
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct Direct {
+    pub b: [f64; 3],
+    pub vis: Vis,
+    /// The polygon whose whole faces `vis` numbers (a point on an edge two polygons share is
+    /// gathered as one of them).
+    pub polygon: u32,
+}
+
+/// The points a point lies between (a midpoint its edge's ends, a centre its element's
+/// corners), the first `.1` of them: what tells its gather which whole faces it sees.
+pub(super) type Parents = ([DVec2; 4], u8);
+
+/// A corner's: none.
+pub(super) const NO_PARENTS: Parents = ([DVec2::ZERO; 4], 0);
+
 /// The values gathered so far, and the rays they cost.
 #[derive(Default)]
 pub(super) struct Values {
-    pub map: HashMap<At, [f64; 3]>,
+    pub map: HashMap<At, Direct>,
     /// [`super::CornerLight::Split`]: the indirect light at the patches' nodes, and the
     /// variance of each (scalar; the gather's own, from its strata: what the refinement's
     /// test takes for noise).
@@ -37,16 +57,19 @@ const CHUNK: usize = 1 << 16;
 /// increasing order; `locate` says where each listed point is kept and lies) and `map` lacks,
 /// once, by the first patch listing it, in parallel, into `map`, [`CHUNK`] patches at a time
 /// (the same patch gathers each point as if all were listed at once): the map itself marks
-/// what is asked for already (`blank` until gathered). Returns the rays cast and the points
-/// gathered.
-pub(super) fn gather_new<P: Copy + Send, V: Copy + Send + Sync>(
+/// what is asked for already (`blank` until gathered). The points `later` picks are gathered
+/// after the others of their chunk, and `gather` reads the map as it stands then (a midpoint
+/// reads what its edge's ends, gathered first, told: [`Direct::vis`]). Returns the rays cast
+/// and the points gathered.
+pub(super) fn gather_new<P: Copy + Send + Sync, V: Copy + Send + Sync>(
     map: &mut HashMap<At, V>,
     (n, patch): (usize, impl Fn(usize) -> usize + Sync + Send),
-    (list, locate): (
+    (list, locate, later): (
         impl Fn(usize) -> Vec<P> + Sync + Send,
         impl Fn(usize, P) -> (At, DVec3),
+        impl Fn(P) -> bool,
     ),
-    gather: impl Fn(usize, DVec3) -> (V, u64) + Sync + Send,
+    gather: impl Fn(&HashMap<At, V>, usize, P, DVec3) -> (V, u64) + Sync + Send,
     blank: V,
 ) -> (u64, u64) {
     let (mut rays, mut gathered) = (0, 0);
@@ -56,23 +79,28 @@ pub(super) fn gather_new<P: Copy + Send, V: Copy + Send + Sync>(
             .into_par_iter()
             .map(|k| (patch(k), list(patch(k))))
             .collect();
-        let mut todo = Vec::new();
+        let mut todo = [Vec::new(), Vec::new()];
         for (i, points) in &lists {
             for &p in points {
                 let (at, x) = locate(*i, p);
                 if let std::collections::hash_map::Entry::Vacant(v) = map.entry(at) {
                     // Filled below, before anything reads it.
                     v.insert(blank);
-                    todo.push((at, *i, x));
+                    todo[usize::from(later(p))].push((at, *i, x, p));
                 }
             }
         }
         drop(lists);
-        let got: Vec<(V, u64)> = (todo.par_iter()).map(|&(_, i, x)| gather(i, x)).collect();
-        gathered += todo.len() as u64;
-        for ((at, _, _), (value, r)) in todo.into_iter().zip(got) {
-            map.insert(at, value);
-            rays += r;
+        for todo in todo {
+            let m = &*map;
+            let got: Vec<(V, u64)> = (todo.par_iter())
+                .map(|&(_, i, x, p)| gather(m, i, p, x))
+                .collect();
+            gathered += todo.len() as u64;
+            for ((at, _, _, _), (value, r)) in todo.into_iter().zip(got) {
+                map.insert(at, value);
+                rays += r;
+            }
         }
     }
     (rays, gathered)

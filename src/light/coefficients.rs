@@ -95,6 +95,7 @@ impl<I: Intersector> Kernel<'_, I> {
                     rays: rays.max(4),
                     lights: true,
                     parts: LightParts::All,
+                    known: Default::default(),
                 };
                 let g = self.gather_at(&spot, ask, &mut rng);
                 out.rays += g.rays;

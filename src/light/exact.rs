@@ -28,6 +28,13 @@
 //! not unbiased: a penumbra that every first-stage ray of its unit misses reads as lit or
 //! dark (measured: docs/results/adaptive-elements.md).
 //!
+//! **Told by the points around** ([`Vis`](super::gather::Vis)): a gather reports which faces its units saw whole
+//! or not at all (a face that gives the point no light counts as not seen: it lies behind the
+//! point's plane or the point behind its own, which holds across a planar patch as it holds
+//! at the patch's corners), and takes the faces its caller says the points around it all saw
+//! alike as seen so, with no ray (`Ask::known`; the adaptive elements' midpoints, from their
+//! edge's or element's corners). Its rays go to the other faces only.
+//!
 //! The emitters taken whole are the ones the polygon's cut holds as leaves of their own, each
 //! drawn with probability at least `emitters::WHOLE_MASS` (`Emitters::whole`); the rest keep
 //! their light samples at their MIS weights (a sample that draws a whole emitter counts 0, no
@@ -35,7 +42,7 @@
 //! light out entirely: the two parts still add up to the whole light.
 
 use super::emitters::Shape;
-use super::gather::{latin, stratified_var, Gathered, Split, Spot};
+use super::gather::{latin, stratified_var, Gathered, Split, Spot, Vis};
 use super::{scalar, Kernel, Origin, Rgb};
 use crate::intersect::Intersector;
 use glam::DVec3;
@@ -130,7 +137,15 @@ impl<I: Intersector> Kernel<'_, I> {
         let from = spot.origin(0.5, 0.5);
         let n = split.direct.max(1);
         let first = (n / FIRST_STAGE).max(1);
-        let (whole, mut units) = whole_units(&split.whole.shapes, &from, first);
+        let (all, known) = (whole_faces(&split.whole.shapes, &from), split.known);
+        // The faces the points around this one saw whole or not at all, seen alike here
+        // (module notes, "Told by the corners"): no ray.
+        let told = |w: &Whole| (known.lit | known.dark) & bit(w.shape) != 0;
+        let given: Rgb = (all.iter())
+            .filter(|w| told(w) && known.lit & bit(w.shape) != 0)
+            .map(|w| w.open)
+            .sum();
+        let (whole, mut units) = whole_units(all.iter().filter(|w| !told(w)).cloned(), first);
         // Stage one: a third of the rays over the whole faces by their unoccluded light;
         // stage two: the rest over those of the units whose rays disagreed or that none told.
         let at = (&from, &split.whole.shapes[..]);
@@ -152,7 +167,8 @@ impl<I: Intersector> Kernel<'_, I> {
             })
             .collect();
         let k = g.ch.len();
-        let mut sum = Rgb::ZERO;
+        let mut sum = given;
+        g.vis = told_here(split.whole.shapes.len(), &all, known, &whole, &units);
         for w in &whole {
             let light = w.open * seen[w.unit];
             sum += light;
@@ -211,10 +227,14 @@ impl<I: Intersector> Kernel<'_, I> {
     ) {
         let picked: Vec<&Whole> = whole.iter().filter(|w| which(w.unit)).collect();
         let total: f64 = picked.iter().map(|w| scalar(w.open)).sum();
+        // Drawn whether or not any face is left to cast to (the faces told by the points
+        // around take none): the light samples after them then draw the same numbers at every
+        // point of the polygon, whose differences are then the light's, not the noise's.
+        let draws = latin(count, true, rng);
         if count == 0 || total <= 0.0 {
             return;
         }
-        for (s, t) in latin(count, true, rng) {
+        for (s, t) in draws {
             // The face at s along the CDF of their light, its member at the rest of s by area.
             let mut x = f64::from(s) * total;
             let mut at = picked[picked.len() - 1];
@@ -254,20 +274,24 @@ impl<I: Intersector> Kernel<'_, I> {
     }
 }
 
-/// The whole faces that give `from` light unoccluded, and the units their visibility is told
-/// by: one per face (a lamp's face is seen or not as one) that gives at least 2/`first` of
-/// their light — so the first stage's stratified rays reach it — and one for all the rest
-/// together.
-fn whole_units(shapes: &[Shape], from: &Origin, first: usize) -> (Vec<Whole>, Vec<Unit>) {
+/// The whole faces that give `from` light unoccluded, each with that light.
+fn whole_faces(shapes: &[Shape], from: &Origin) -> Vec<Whole> {
     let (x, n) = (from.x.as_dvec3(), from.n.as_dvec3());
-    let mut out: Vec<Whole> = (shapes.iter().enumerate())
+    (shapes.iter().enumerate())
         .map(|(k, sh)| Whole {
             shape: k,
             open: shape_light(sh, x, n),
             unit: 0,
         })
         .filter(|w| scalar(w.open) > 0.0)
-        .collect();
+        .collect()
+}
+
+/// The units the visibility of the faces `faces` is told by: one per face (a lamp's face is
+/// seen or not as one) that gives at least 2/`first` of their light — so the first stage's
+/// stratified rays reach it — and one for all the rest together.
+fn whole_units(faces: impl Iterator<Item = Whole>, first: usize) -> (Vec<Whole>, Vec<Unit>) {
+    let mut out: Vec<Whole> = faces.collect();
     let total: f64 = out.iter().map(|w| scalar(w.open)).sum();
     let mut big = 0;
     for w in &mut out {
@@ -280,7 +304,45 @@ fn whole_units(shapes: &[Shape], from: &Origin, first: usize) -> (Vec<Whole>, Ve
     (out, units)
 }
 
+/// Face `k`'s bit in a [`Vis`] (faces past the 64th have none: always told by rays).
+fn bit(k: usize) -> u64 {
+    if k < 64 {
+        1 << k
+    } else {
+        0
+    }
+}
+
+/// What a point's gather tells of each of its polygon's `count` whole faces: seen whole (every
+/// ray its unit cast arrived, or the points around said so), or dark (every ray blocked, the
+/// points around said so, or the face gives the point no light: it lies behind the point's
+/// plane, or the point behind the face's, which holds across a patch as it holds at its
+/// corners).
+fn told_here(count: usize, all: &[Whole], known: Vis, whole: &[Whole], units: &[Unit]) -> Vis {
+    let mut v = Vis {
+        lit: known.lit,
+        dark: known.dark,
+    };
+    let lights: u64 = all.iter().map(|w| bit(w.shape)).fold(0, |a, b| a | b);
+    let faces = if count >= 64 {
+        u64::MAX
+    } else {
+        (1u64 << count) - 1
+    };
+    v.dark |= faces & !lights;
+    for w in whole {
+        let u = &units[w.unit];
+        if u.settled() && u.lit {
+            v.lit |= bit(w.shape);
+        } else if u.settled() && u.dark {
+            v.dark |= bit(w.shape);
+        }
+    }
+    v
+}
+
 /// One whole face at a point: its unoccluded light and the unit its visibility is told by.
+#[derive(Clone)]
 struct Whole {
     shape: usize,
     open: Rgb,

@@ -71,6 +71,29 @@ pub(crate) struct Gathered {
     pub var: f64,
     pub rays: u64,
     pub reflected: Rgb,
+    /// With [`LightParts::DirectWhole`], what its rays told of the whole faces
+    /// ([`Vis`]).
+    pub vis: Vis,
+}
+
+/// What a gather of the direct light in parts (`LightParts::DirectWhole`) found of its
+/// polygon's whole faces (bit k: face k of its `WholeSet`): each seen whole (`lit`) or not at
+/// all (`dark`); neither where its rays disagreed. Handed the other way ([`Ask`]),
+/// what the points around a point found alike, which that point then takes without a ray.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Vis {
+    pub lit: u64,
+    pub dark: u64,
+}
+
+impl Vis {
+    /// What both `self` and `o` tell.
+    pub fn and(self, o: Vis) -> Vis {
+        Vis {
+            lit: self.lit & o.lit,
+            dark: self.dark & o.dark,
+        }
+    }
 }
 
 /// Where a gather is made: the points `at(u, v)` of the unit square's map (a patch's, or one
@@ -105,6 +128,10 @@ pub(crate) struct Ask {
     pub rays: usize,
     pub lights: bool,
     pub parts: LightParts,
+    /// [`LightParts::DirectWhole`]: the whole faces the points around this one all saw whole
+    /// or all not at all, taken so here without a ray (the adaptive elements' midpoints,
+    /// from their edge's or element's corners). Nothing told by default.
+    pub known: Vis,
 }
 
 /// How a gather's rays are shared out: light samples of the emitters and of the sun, the
@@ -130,6 +157,8 @@ pub(super) struct Split {
     /// their light is `DirectWhole`'s alone, and `IndirectOnce`'s hemisphere rays leave it
     /// out. Empty for the other parts.
     pub whole: WholeSet,
+    /// [`Ask::known`].
+    pub known: Vis,
 }
 
 impl Split {
@@ -176,6 +205,7 @@ impl Split {
             nc,
             weigh: (parts != LightParts::All && lamps).then(Draw::by_power),
             whole,
+            known: Vis::default(),
             follow: if parts == LightParts::IndirectOnce {
                 1
             } else {
@@ -208,6 +238,7 @@ impl<I: Intersector> Kernel<'_, I> {
             var: 0.0,
             rays: 0,
             reflected: Rgb::ZERO,
+            vis: Default::default(),
         };
         let lamps = !self.emitters.is_empty() && ask.lights;
         // A gather draws its emitters by what they can give its spot (none: no light samples
@@ -246,7 +277,8 @@ impl<I: Intersector> Kernel<'_, I> {
             }
         };
         let sun = self.sky.sun();
-        let split = Split::new(ask.parts, (draw, whole), sun.is_some(), ask.rays);
+        let mut split = Split::new(ask.parts, (draw, whole), sun.is_some(), ask.rays);
+        split.known = ask.known;
         if split.direct > 0 && ask.parts == LightParts::DirectWhole {
             self.whole_direct_part(spot, &split, &mut g, rng);
         } else if split.direct > 0 {

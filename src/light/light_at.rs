@@ -11,6 +11,7 @@
 //! as sharp as the geometry makes them, not as the mesh does, and corners and narrow gaps are
 //! not blotchy with the constant B of the patches beside them.
 
+pub use super::gather::Vis;
 use super::gather::{Ask, Spot};
 use super::hemisphere::MAX_STEPS;
 use super::{emission_and_reflectance, scalar, Kernel, LightParts, Rgb, Solved, NO_PATCH};
@@ -53,6 +54,17 @@ pub struct ViewSeen {
     pub panes: Rgb,
     /// Rays cast.
     pub rays: u64,
+}
+
+/// What [`LightAt::part_told_at`] gathered: the value, the variance of the scalar ρ·H it
+/// gathered (of its mean), the rays cast and what the rays told of the whole faces ([`Vis`];
+/// nothing but for `DirectWhole`).
+#[derive(Clone, Copy, Debug)]
+pub struct PartAt {
+    pub b: Rgb,
+    pub var: f64,
+    pub rays: u64,
+    pub vis: Vis,
 }
 
 /// The lights of a relit solution (`radiosity relight`): each patch's emitted radiosity E
@@ -232,11 +244,31 @@ impl<'a, I: Intersector> LightAt<'a, I> {
         parts: LightParts,
         rng: &mut R,
     ) -> (Rgb, f64, u64) {
+        let p = self.part_told_at(patch, points, (rays, parts), Vis::default(), rng);
+        (p.b, p.var, p.rays)
+    }
+
+    /// [`Self::part_at`], the whole faces `known` as the points around said
+    /// ([`super::gather::Ask::known`]), with what its rays told of the whole faces
+    /// (`DirectWhole`).
+    pub fn part_told_at<R: Rng>(
+        &self,
+        patch: usize,
+        points: &[Vec3],
+        (rays, parts): (usize, LightParts),
+        known: Vis,
+        rng: &mut R,
+    ) -> PartAt {
         let k = &self.kernel;
         let (e, rho) = (k.sol.e[patch], k.sol.rho[patch]);
         let e = if parts.direct() { e } else { Rgb::ZERO };
         if points.is_empty() || scalar(rho) <= 0.0 {
-            return (e, 0.0, 0);
+            return PartAt {
+                b: e,
+                var: 0.0,
+                rays: 0,
+                vis: Vis::default(),
+            };
         }
         let m = points.len();
         let at = |u: f32, _: f32| points[((u * m as f32) as usize).min(m - 1)];
@@ -251,13 +283,19 @@ impl<'a, I: Intersector> LightAt<'a, I> {
             rays: rays.max(2),
             lights: *self.facing[patch].get_or_init(|| self.lit_by_an_emitter(patch)),
             parts,
+            known,
         };
         let g = k.gather_at(&spot, ask, rng);
         let b = (e + rho * g.h)
             .to_array()
             .map(|v| if v.is_finite() { v.max(0.0) } else { 0.0 });
         let var = if g.var.is_finite() { g.var } else { 0.0 };
-        (Rgb::from_array(b), var, g.rays)
+        PartAt {
+            b: Rgb::from_array(b),
+            var,
+            rays: g.rays,
+            vis: g.vis,
+        }
     }
 
     /// Irradiance (RGB, W/m²) at sensors (point, facing direction) from the solved radiosity
@@ -290,6 +328,7 @@ impl<'a, I: Intersector> LightAt<'a, I> {
                     rays,
                     lights: true,
                     parts: LightParts::All,
+                    known: Default::default(),
                 };
                 k.gather_at(&spot, ask, &mut rng).h.to_array()
             })

@@ -63,7 +63,7 @@ pub mod sun;
 
 pub use gather::LightParts;
 pub use hemisphere::{NEAR, NEAR_DEPTH};
-pub use light_at::{LightAt, Relit, ViewHit, ViewSeen};
+pub use light_at::{LightAt, PartAt, Relit, ViewHit, ViewSeen, Vis};
 
 use crate::mesh::Mesh;
 use crate::scene::Material;

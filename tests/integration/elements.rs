@@ -490,3 +490,33 @@ fn split_direct_light_takes_the_rooms_lamp_whole() {
         }
     });
 }
+
+/// A point handed what its own shadow rays told of its polygon's whole lamp faces (its room's
+/// lamp seen whole, the others' behind walls hidden) gets the same light with fewer rays, and
+/// told its lamp is hidden, none of that lamp's light.
+#[test]
+fn a_point_told_its_lamps_are_seen_casts_fewer_rays() {
+    use radiosity::light::{LightParts, Vis};
+    use rand::SeedableRng;
+    in_room_floor(|_, _, light, patch, at| {
+        let gather = |known: Vis| {
+            let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(1);
+            let ask = (24, LightParts::DirectWhole);
+            light.part_told_at(patch, &at, ask, known, &mut rng)
+        };
+        let own = gather(Vis::default());
+        assert!(own.rays > 0 && own.vis.lit != 0, "{own:?}");
+        let told = gather(own.vis);
+        let size = own.b.max_element();
+        assert!(
+            (told.b - own.b).abs().max_element() < 1e-9 * size,
+            "{told:?} {own:?}"
+        );
+        assert!(told.rays < own.rays, "{told:?} {own:?}");
+        let hidden = gather(Vis {
+            lit: 0,
+            dark: own.vis.lit,
+        });
+        assert!(hidden.b.max_element() < 0.1 * size, "{hidden:?} {own:?}");
+    });
+}

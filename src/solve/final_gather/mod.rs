@@ -134,6 +134,7 @@ fn gather_patch<I: Intersector>(
         rays,
         lights: true,
         parts: LightParts::All,
+        known: Default::default(),
     };
     kernel.gather_learning(&spot, ask, Some(learned), &mut rng)
 }
@@ -697,6 +698,7 @@ fn pooled(g1: &Gathered, n1: usize, g2: &Gathered, n2: usize) -> Gathered {
         var: w1 * w1 * g1.var + w2 * w2 * g2.var,
         rays: g1.rays + g2.rays,
         reflected: w1 * g1.reflected + w2 * g2.reflected,
+        vis: Default::default(),
     }
 }
 
@@ -711,6 +713,7 @@ mod tests {
             var,
             rays,
             reflected: Rgb::splat(h),
+            vis: Default::default(),
         }
     }
 

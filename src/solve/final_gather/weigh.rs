@@ -97,6 +97,7 @@ mod tests {
             var: 1e-4 * h * h,
             rays: 64,
             reflected: Rgb::splat(reflected),
+            vis: Default::default(),
         }
     }
 
