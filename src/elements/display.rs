@@ -30,7 +30,7 @@ use super::refine::{facing, key, PatchWork, Refiner};
 use crate::intersect::Intersector;
 use crate::mesh::{newell, Mesh, Patch, Side};
 use glam::{DVec3, Vec3};
-use std::collections::HashMap;
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 /// The element mesh and what it holds per element and per vertex.
 pub(super) struct Built {
@@ -53,7 +53,7 @@ pub(super) fn build<I: Intersector>(r: &Refiner<'_, I>, work: Vec<PatchWork>, ra
         patch_size: mesh.patch_size,
         ..Mesh::default()
     };
-    let mut weld: HashMap<WeldKey, u32> = HashMap::new();
+    let mut weld: HashMap<WeldKey, u32> = HashMap::default();
     let mut sum: Vec<[f64; 3]> = Vec::new();
     let mut count: Vec<u32> = Vec::new();
     let mut patch_of = Vec::new();
@@ -61,7 +61,7 @@ pub(super) fn build<I: Intersector>(r: &Refiner<'_, I>, work: Vec<PatchWork>, ra
     for (i, w) in work.iter().enumerate() {
         let p = &mesh.patches[i];
         let facing = facing(p.normal);
-        let mut counted = std::collections::HashSet::new();
+        let mut counted = HashSet::default();
         let mut values = w.corner_b.iter();
         for e in &w.done {
             let pts = e.corners(&w.roots);

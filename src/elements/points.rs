@@ -9,7 +9,7 @@ use crate::intersect::Intersector;
 use crate::light::{LightParts, Vis};
 use crate::solve::{rng_for, Stream};
 use glam::{DVec2, DVec3};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 impl<I: Intersector> Refiner<'_, I> {
     /// Gathers at `x`, as patch `patch` (module notes): the direct light, or all of it; the

@@ -9,7 +9,7 @@ use crate::light::Vis;
 use crate::mesh::Mesh;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
-use std::collections::{HashMap, HashSet};
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 /// Where a point's value is kept ([`super::refine`]'s notes, "Shared points"): its position,
 /// facing and material, as the mesh welds its vertices.
