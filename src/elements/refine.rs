@@ -36,7 +36,7 @@
 //!
 //! **Told by the corners.** A point's direct light is the closed form of each whole lamp face
 //! times what its shadow rays find unblocked (`light::exact`); where every ray of a face
-//! arrived, or none did, the gather says so ([`Vis`]). A level gathers its elements' corners
+//! arrived, or none did, the gather says so ([`crate::light::Vis`]). A level gathers its elements' corners
 //! first, then the points between them: an edge's midpoint takes as seen (or hidden) the faces
 //! both ends of its edge saw whole (or not at all), a quad's centre those all four corners
 //! did, and casts rays only to the rest — in a room most points see their lamps whole, so a
@@ -47,7 +47,7 @@
 //! rays. Only points of the same polygon tell each other (the faces are numbered per polygon).
 //!
 //! **Common random numbers.** Every point of one scene polygon is gathered with a generator
-//! seeded alike, from (seed, [`Stream::Elements`], polygon): neighbouring corners then use the
+//! seeded alike, from (seed, [`crate::solve::Stream::Elements`], polygon): neighbouring corners then use the
 //! same directions and light samples, so the difference between two corners — what the
 //! refinement tests — is the light's, not the noise's.
 //!

@@ -28,7 +28,7 @@
 //! not unbiased: a penumbra that every first-stage ray of its unit misses reads as lit or
 //! dark (measured: docs/results/adaptive-elements.md).
 //!
-//! **Told by the points around** ([`Vis`](super::gather::Vis)): a gather reports which faces its units saw whole
+//! **Told by the points around** ([`Vis`]): a gather reports which faces its units saw whole
 //! or not at all (a face that gives the point no light counts as not seen: it lies behind the
 //! point's plane or the point behind its own, which holds across a planar patch as it holds
 //! at the patch's corners), and takes the faces its caller says the points around it all saw

@@ -78,7 +78,7 @@ pub(crate) struct Gathered {
 
 /// What a gather of the direct light in parts (`LightParts::DirectWhole`) found of its
 /// polygon's whole faces (bit k: face k of its `WholeSet`): each seen whole (`lit`) or not at
-/// all (`dark`); neither where its rays disagreed. Handed the other way ([`Ask`]),
+/// all (`dark`); neither where its rays disagreed. Handed the other way (`Ask`),
 /// what the points around a point found alike, which that point then takes without a ray.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Vis {

@@ -249,7 +249,7 @@ impl<'a, I: Intersector> LightAt<'a, I> {
     }
 
     /// [`Self::part_at`], the whole faces `known` as the points around said
-    /// ([`super::gather::Ask::known`]), with what its rays told of the whole faces
+    /// (`Ask::known`), with what its rays told of the whole faces
     /// (`DirectWhole`).
     pub fn part_told_at<R: Rng>(
         &self,
