@@ -6,7 +6,7 @@
 use super::refine::{big_enough, test_points, CornerLight, Refiner, Rule};
 use super::work::{gather_new, At, Direct, Parents, PatchWork, Values, NO_PARENTS};
 use crate::intersect::Intersector;
-use crate::light::{LightParts, Vis};
+use crate::light::{LightParts, PartAt, Vis};
 use crate::solve::{rng_for, Stream};
 use glam::{DVec2, DVec3};
 use rustc_hash::FxHashMap as HashMap;
@@ -15,37 +15,18 @@ impl<I: Intersector> Refiner<'_, I> {
     /// Gathers at `x`, as patch `patch` (module notes): the direct light, or all of it; the
     /// direct light taking the whole faces `known` tells as told ("Told by the corners").
     fn gather_one(&self, patch: usize, x: DVec3, known: Vis) -> (Direct, u64) {
-        if self.light == CornerLight::Full {
-            let (b, _, rays) = self.gather_part(patch, x, LightParts::All, self.rays);
-            let polygon = self.mesh.patches[patch].polygon;
-            return (
-                Direct {
-                    b,
-                    vis: known,
-                    polygon,
-                },
-                rays,
-            );
-        }
+        let parts = match self.light {
+            CornerLight::Full => LightParts::All,
+            CornerLight::Direct | CornerLight::Split => LightParts::DirectWhole,
+        };
+        let (b, got) = self.gather_told(patch, x, (self.rays, parts), known);
         let polygon = self.mesh.patches[patch].polygon;
-        let mut rng = rng_for(self.seed, Stream::Elements, polygon as u64);
-        let pts = [x.as_vec3()];
-        let ask = (self.rays, LightParts::DirectWhole);
-        let got = (self.gather).part_told_at(patch, &pts, ask, known, &mut rng);
-        let b = (got.b)
-            .to_array()
-            .map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
-        (
-            Direct {
-                b,
-                vis: got.vis,
-                polygon,
-            },
-            got.rays,
-        )
+        let vis = got.vis;
+        (Direct { b, vis, polygon }, got.rays)
     }
 
-    /// Gathers `parts` of the light at `x` with `rays` rays, as patch `patch`.
+    /// Gathers `parts` of the light at `x` with `rays` rays, as patch `patch`: its value (0
+    /// where not finite), the variance and the rays.
     pub(super) fn gather_part(
         &self,
         patch: usize,
@@ -53,14 +34,27 @@ impl<I: Intersector> Refiner<'_, I> {
         parts: LightParts,
         rays: usize,
     ) -> ([f64; 3], f64, u64) {
+        let (b, got) = self.gather_told(patch, x, (rays, parts), Vis::default());
+        (b, got.var, got.rays)
+    }
+
+    /// [`Self::gather_part`], the whole faces `known` tells taken as told, with all the gather
+    /// found ([`PartAt`]); every point of a polygon draws from the generator seeded alike
+    /// ("Common random numbers").
+    fn gather_told(
+        &self,
+        patch: usize,
+        x: DVec3,
+        ask: (usize, LightParts),
+        known: Vis,
+    ) -> ([f64; 3], PartAt) {
         let polygon = self.mesh.patches[patch].polygon as u64;
         let mut rng = rng_for(self.seed, Stream::Elements, polygon);
-        let pts = [x.as_vec3()];
-        let (b, var, rays) = self.gather.part_at(patch, &pts, rays, parts, &mut rng);
-        let b = b
+        let got = (self.gather).part_told_at(patch, &[x.as_vec3()], ask, known, &mut rng);
+        let b = (got.b)
             .to_array()
             .map(|x| if x.is_finite() { x.max(0.0) } else { 0.0 });
-        (b, var, rays)
+        (b, got)
     }
 
     /// Gathers the points `want` lists for each patch (the points' parameters, by root, each

@@ -126,23 +126,24 @@ impl<I: Intersector> Kernel<'_, I> {
     /// (`split.whole`) in closed form, each times what its shadow rays find unblocked, in two
     /// stages (module notes); the others' by `split.direct` light samples as
     /// [`Self::direct_part`] takes them (a sample that draws a whole emitter counts 0 and
-    /// casts nothing). Into `g`.
+    /// casts nothing); the faces `known` tells taken as told (module notes, "Told by the points
+    /// around"). Into `g`, with what its rays told ([`Gathered::vis`]).
     pub(super) fn whole_direct_part<R: Rng>(
         &self,
         spot: &Spot,
-        split: &Split,
+        (split, known): (&Split, Vis),
         g: &mut Gathered,
         rng: &mut R,
     ) {
         let from = spot.origin(0.5, 0.5);
         let n = split.direct.max(1);
         let first = (n / FIRST_STAGE).max(1);
-        let (all, known) = (whole_faces(&split.whole.shapes, &from), split.known);
+        let all = whole_faces(&split.whole.shapes, &from);
         // The faces the points around this one saw whole or not at all, seen alike here
-        // (module notes, "Told by the corners"): no ray.
+        // (module notes, "Told by the points around"): no ray.
         let told = |w: &Whole| (known.lit | known.dark) & bit(w.shape) != 0;
         let given: Rgb = (all.iter())
-            .filter(|w| told(w) && known.lit & bit(w.shape) != 0)
+            .filter(|w| known.lit & bit(w.shape) != 0)
             .map(|w| w.open)
             .sum();
         let (whole, mut units) = whole_units(all.iter().filter(|w| !told(w)).cloned(), first);
@@ -319,10 +320,7 @@ fn bit(k: usize) -> u64 {
 /// plane, or the point behind the face's, which holds across a patch as it holds at its
 /// corners).
 fn told_here(count: usize, all: &[Whole], known: Vis, whole: &[Whole], units: &[Unit]) -> Vis {
-    let mut v = Vis {
-        lit: known.lit,
-        dark: known.dark,
-    };
+    let mut v = known;
     let lights: u64 = all.iter().map(|w| bit(w.shape)).fold(0, |a, b| a | b);
     let faces = if count >= 64 {
         u64::MAX

@@ -157,8 +157,6 @@ pub(super) struct Split {
     /// their light is `DirectWhole`'s alone, and `IndirectOnce`'s hemisphere rays leave it
     /// out. Empty for the other parts.
     pub whole: WholeSet,
-    /// [`Ask::known`].
-    pub known: Vis,
 }
 
 impl Split {
@@ -205,7 +203,6 @@ impl Split {
             nc,
             weigh: (parts != LightParts::All && lamps).then(Draw::by_power),
             whole,
-            known: Vis::default(),
             follow: if parts == LightParts::IndirectOnce {
                 1
             } else {
@@ -277,10 +274,9 @@ impl<I: Intersector> Kernel<'_, I> {
             }
         };
         let sun = self.sky.sun();
-        let mut split = Split::new(ask.parts, (draw, whole), sun.is_some(), ask.rays);
-        split.known = ask.known;
+        let split = Split::new(ask.parts, (draw, whole), sun.is_some(), ask.rays);
         if split.direct > 0 && ask.parts == LightParts::DirectWhole {
-            self.whole_direct_part(spot, &split, &mut g, rng);
+            self.whole_direct_part(spot, (&split, ask.known), &mut g, rng);
         } else if split.direct > 0 {
             self.direct_part(spot, &split, &mut g, learned.as_deref_mut(), rng);
         }
