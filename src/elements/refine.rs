@@ -36,20 +36,21 @@
 //!
 //! **Told by the corners.** A point's direct light is the closed form of each whole lamp face
 //! times what its shadow rays find unblocked (`light::exact`); where every ray of a face
-//! arrived, or none did, the gather says so ([`crate::light::Vis`]). A level gathers its elements' corners
-//! first, then the points between them: an edge's midpoint takes as seen (or hidden) the faces
-//! both ends of its edge saw whole (or not at all), a quad's centre those all four corners
-//! did, and casts rays only to the rest — in a room most points see their lamps whole, so a
-//! midpoint there costs the closed form and no ray. A shadow smaller than an element that
-//! falls between its corners is then missed where the midpoint's own rays might have met it
-//! (a third of them, eight at the default, might not either); measured with `bench elements`
-//! (docs/results/adaptive-elements.md): the same error on `scenes/spot.obj` for 16 % fewer
-//! rays. Only points of the same polygon tell each other (the faces are numbered per polygon).
+//! arrived, or none did, the gather says so ([`crate::light::Vis`]). A level gathers its
+//! elements' corners first, then the points between them: an edge's midpoint takes as seen
+//! (or hidden) the faces both ends of its edge saw whole (or not at all), a quad's centre
+//! those all four corners did, and casts rays only to the rest — in a room most points see
+//! their lamps whole, so a midpoint there costs the closed form and no ray. A shadow smaller
+//! than an element that falls between its corners is then missed where the midpoint's own
+//! rays might have met it (a third of them, eight at the default, might not either);
+//! measured with `bench elements` (docs/results/adaptive-elements.md): the same error on
+//! `scenes/spot.obj` for 16 % fewer rays. Only points of the same polygon tell each other
+//! (the faces are numbered per polygon).
 //!
 //! **Common random numbers.** Every point of one scene polygon is gathered with a generator
-//! seeded alike, from (seed, [`crate::solve::Stream::Elements`], polygon): neighbouring corners then use the
-//! same directions and light samples, so the difference between two corners — what the
-//! refinement tests — is the light's, not the noise's.
+//! seeded alike, from (seed, [`crate::solve::Stream::Elements`], polygon): neighbouring
+//! corners then use the same directions and light samples, so the difference between two
+//! corners — what the refinement tests — is the light's, not the noise's.
 //!
 //! **Reproducible**: each level first lists the points its tests need, gathers the new ones in
 //! parallel (a point's value depends only on the point and the patch chosen to gather it),
